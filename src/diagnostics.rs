@@ -1,0 +1,218 @@
+//! What the last step did: energies, momentum, counts and where the time went.
+//!
+//! Energies are in J, momentum in kg·m/s, times in wall-clock durations.
+//! - kinetic T = Σ ½ m |v|² over particles and mesh nodes (pinned bodies excluded);
+//! - gravitational U_g = −Σ m g·x (zero at the origin);
+//! - spring U_s = Σ ½ k (l − r)²;
+//! - linear momentum P = Σ m v.
+//!
+//! The energy pass reads every body once per step; turn it off with
+//! [`DiagnosticsSettings::energy`] when a scene is too large to afford it. Timings per set
+//! are summed over the substeps of the last step.
+
+use std::time::{Duration, Instant};
+
+use bevy_ecs::prelude::*;
+use glam::{DVec3, Vec3};
+
+use crate::particles::{Gravity, LinearVelocity, Mass, Nodes, Position, Tracer};
+use crate::quarantine::{QuarantineReason, Quarantined};
+use crate::schedule::{
+    PhysicsSchedule, PhysicsSystems, ProbeSystems, StepSystems, SubstepSchedule, add_systems,
+};
+use crate::springs::{Spring, SpringNetwork, spring_energy};
+
+/// How many things of each kind the world holds (quarantined ones counted apart).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct BodyCounts {
+    /// Particle entities (with [`Mass`]).
+    pub particles: usize,
+    /// Tracers.
+    pub tracers: usize,
+    /// Spring entities.
+    pub springs: usize,
+    /// Mesh entities (with [`Nodes`]).
+    pub meshes: usize,
+    /// Nodes over all meshes.
+    pub mesh_nodes: usize,
+    /// Springs over all spring networks.
+    pub mesh_springs: usize,
+    /// Entities currently quarantined.
+    pub quarantined: usize,
+}
+
+/// Diagnostics of the last step. A resource.
+#[derive(Resource, Debug, Clone, Default)]
+pub struct PhysicsDiagnostics {
+    /// Kinetic energy (J).
+    pub kinetic_energy: f64,
+    /// Gravitational potential energy relative to the origin (J).
+    pub gravitational_energy: f64,
+    /// Elastic energy stored in springs (J).
+    pub spring_energy: f64,
+    /// Total linear momentum (kg·m/s).
+    pub linear_momentum: Vec3,
+    /// Entity counts.
+    pub counts: BodyCounts,
+    /// Wall time per [`StepSystems`] set, in `StepSystems::ORDER`, summed over substeps.
+    pub set_times: [Duration; 8],
+    /// Wall time of the whole last step.
+    pub step_time: Duration,
+    /// Bodies quarantined since the world started.
+    pub quarantined_total: u64,
+    /// The most recent quarantine.
+    pub last_quarantined: Option<(Entity, QuarantineReason)>,
+    /// Frame time dropped by the step cap in the last `advance_physics` call (s).
+    pub dropped_time: f32,
+}
+
+impl PhysicsDiagnostics {
+    /// Kinetic + gravitational + spring energy (J).
+    #[must_use]
+    pub fn total_energy(&self) -> f64 {
+        self.kinetic_energy + self.gravitational_energy + self.spring_energy
+    }
+
+    /// Wall time of one set in the last step.
+    #[must_use]
+    pub fn set_time(&self, set: StepSystems) -> Duration {
+        let i = StepSystems::ORDER
+            .iter()
+            .position(|s| *s == set)
+            .unwrap_or(0);
+        self.set_times[i]
+    }
+}
+
+/// What the diagnostics measure.
+#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DiagnosticsSettings {
+    /// Compute energies, momentum and counts every step (one read of every body).
+    pub energy: bool,
+    /// Time every set (two clock reads per set per substep).
+    pub timings: bool,
+}
+
+impl Default for DiagnosticsSettings {
+    fn default() -> Self {
+        Self {
+            energy: true,
+            timings: true,
+        }
+    }
+}
+
+#[derive(Resource, Default)]
+struct SetClock {
+    last: Option<Instant>,
+    acc: [Duration; 8],
+}
+
+pub(crate) fn install(world: &mut World) {
+    world.init_resource::<PhysicsDiagnostics>();
+    world.init_resource::<DiagnosticsSettings>();
+    world.init_resource::<SetClock>();
+    for k in 0..=8u8 {
+        add_systems(
+            world,
+            SubstepSchedule,
+            (move |mut clock: ResMut<SetClock>| {
+                let now = Instant::now();
+                if let (Some(last), Some(slot)) = (clock.last, (k as usize).checked_sub(1)) {
+                    clock.acc[slot] += now - last;
+                }
+                clock.last = Some(now);
+            })
+            .run_if(timings_on)
+            .in_set(ProbeSystems(k)),
+        );
+    }
+    add_systems(
+        world,
+        PhysicsSchedule,
+        (
+            reset_clock
+                .run_if(timings_on)
+                .in_set(PhysicsSystems::Prepare),
+            (
+                publish_timings.run_if(timings_on),
+                measure_energy.run_if(|s: Res<DiagnosticsSettings>| s.energy),
+            )
+                .chain()
+                .in_set(PhysicsSystems::Finish),
+        ),
+    );
+}
+
+fn timings_on(s: Res<DiagnosticsSettings>) -> bool {
+    s.timings
+}
+
+fn reset_clock(mut clock: ResMut<SetClock>) {
+    *clock = SetClock::default();
+}
+
+fn publish_timings(clock: Res<SetClock>, mut diag: ResMut<PhysicsDiagnostics>) {
+    diag.set_times = clock.acc;
+}
+
+type Live = Without<Quarantined>;
+
+#[allow(clippy::too_many_arguments)]
+fn measure_energy(
+    mut diag: ResMut<PhysicsDiagnostics>,
+    gravity: Option<Res<Gravity>>,
+    bodies: Query<(&Position, &LinearVelocity, &Mass), Live>,
+    meshes: Query<(&Nodes, Option<&SpringNetwork>), Live>,
+    springs: Query<&Spring, Live>,
+    states: Query<&Position, Live>,
+    tracers: Query<(), (With<Tracer>, Live)>,
+    quarantined: Query<(), With<Quarantined>>,
+) {
+    let g = gravity.map_or(DVec3::ZERO, |g| g.get().as_dvec3());
+    let (mut t, mut u, mut us, mut p) = (0.0f64, 0.0f64, 0.0f64, DVec3::ZERO);
+    let mut counts = BodyCounts::default();
+    for (x, v, m) in &bodies {
+        counts.particles += 1;
+        if m.is_pinned() {
+            continue;
+        }
+        let (mass, v) = (f64::from(m.value()), v.0.as_dvec3());
+        t += 0.5 * mass * v.length_squared();
+        u -= mass * g.dot(x.0.as_dvec3());
+        p += mass * v;
+    }
+    for (nodes, net) in &meshes {
+        counts.meshes += 1;
+        counts.mesh_nodes += nodes.len();
+        for i in 0..nodes.len() {
+            let mass = f64::from(nodes.mass[i]);
+            let v = Vec3::from(nodes.v[i]).as_dvec3();
+            t += 0.5 * mass * v.length_squared();
+            u -= mass * g.dot(Vec3::from(nodes.x[i]).as_dvec3());
+            p += mass * v;
+        }
+        if let Some(net) = net {
+            counts.mesh_springs += net.len();
+            us += f64::from(net.energy(nodes));
+        }
+    }
+    for s in &springs {
+        counts.springs += 1;
+        if let (Ok(a), Ok(b)) = (states.get(s.a()), states.get(s.b())) {
+            us += f64::from(spring_energy(
+                a.0.into(),
+                b.0.into(),
+                s.rest_length(),
+                s.stiffness(),
+            ));
+        }
+    }
+    counts.tracers = tracers.iter().count();
+    counts.quarantined = quarantined.iter().count();
+    diag.kinetic_energy = t;
+    diag.gravitational_energy = u;
+    diag.spring_energy = us;
+    diag.linear_momentum = p.as_vec3();
+    diag.counts = counts;
+}

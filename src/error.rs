@@ -1,0 +1,118 @@
+//! The crate's typed error.
+//!
+//! Every fallible constructor in hooke returns `Result<_, hooke::Error>`; nothing at the API
+//! edge panics on bad numbers. Each variant names the offending quantity so a game can show
+//! the message to a designer as is.
+
+use bevy_ecs::entity::Entity;
+
+/// Everything that can be wrong with input handed to hooke.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum Error {
+    /// A scalar or vector input was NaN or infinite.
+    #[error("{what} must be finite, got {value}")]
+    NonFinite {
+        /// Which input, e.g. `"position"` or `"spring stiffness"`.
+        what: &'static str,
+        /// The value as text (vectors print all components).
+        value: String,
+    },
+    /// A mass was zero, negative or not finite. Use `Mass::PINNED` for an immovable body.
+    #[error("mass must be positive and finite (kg), got {0}")]
+    InvalidMass(f32),
+    /// A quantity that must not be negative was negative.
+    #[error("{what} must be >= 0, got {value}")]
+    Negative {
+        /// Which input, e.g. `"rest length"`.
+        what: &'static str,
+        /// The rejected value.
+        value: f32,
+    },
+    /// A quantity that must be strictly positive was zero or negative.
+    #[error("{what} must be > 0, got {value}")]
+    NotPositive {
+        /// Which input, e.g. `"rest length"` for the strain-form spring law.
+        what: &'static str,
+        /// The rejected value.
+        value: f32,
+    },
+    /// A spring was asked to join an entity to itself.
+    #[error("a spring cannot connect entity {0} to itself")]
+    SelfSpring(Entity),
+    /// A spring endpoint does not exist, or is not a body (has no `Position`).
+    #[error("spring endpoint {0} does not exist or has no Position")]
+    MissingEntity(Entity),
+    /// The fixed time step was zero, negative or not finite.
+    #[error("time step must be positive and finite (s), got {0}")]
+    InvalidTimeStep(f32),
+    /// A step was asked to run zero substeps.
+    #[error("substeps must be at least 1")]
+    ZeroSubsteps,
+    /// A builder was asked for fewer elements than it needs (e.g. a rope of 1 node).
+    #[error("{what} needs at least {min}, got {got}")]
+    TooFew {
+        /// What was counted, e.g. `"rope nodes"`.
+        what: &'static str,
+        /// The smallest accepted count.
+        min: usize,
+        /// The count given.
+        got: usize,
+    },
+    /// An index into a mesh's node arrays was out of range.
+    #[error("{what} index {index} is out of range for {len} nodes")]
+    IndexOutOfRange {
+        /// Which index, e.g. `"spring endpoint"`.
+        what: &'static str,
+        /// The rejected index.
+        index: usize,
+        /// The number of nodes.
+        len: usize,
+    },
+}
+
+/// Shorthand for hooke results.
+pub type Result<T, E = Error> = core::result::Result<T, E>;
+
+/// Checks that a scalar is finite.
+pub(crate) fn finite(what: &'static str, value: f32) -> Result<f32> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(Error::NonFinite {
+            what,
+            value: value.to_string(),
+        })
+    }
+}
+
+/// Checks that a vector is finite.
+pub(crate) fn finite_vec(what: &'static str, value: glam::Vec3) -> Result<glam::Vec3> {
+    if value.is_finite() {
+        Ok(value)
+    } else {
+        Err(Error::NonFinite {
+            what,
+            value: format!("{value}"),
+        })
+    }
+}
+
+/// Checks that a scalar is finite and not negative.
+pub(crate) fn non_negative(what: &'static str, value: f32) -> Result<f32> {
+    finite(what, value)?;
+    if value < 0.0 {
+        Err(Error::Negative { what, value })
+    } else {
+        Ok(value)
+    }
+}
+
+/// Checks that a scalar is finite and strictly positive.
+pub(crate) fn positive(what: &'static str, value: f32) -> Result<f32> {
+    finite(what, value)?;
+    if value <= 0.0 {
+        Err(Error::NotPositive { what, value })
+    } else {
+        Ok(value)
+    }
+}

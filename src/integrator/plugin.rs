@@ -1,0 +1,389 @@
+//! The integration systems shared by particle entities and [`Nodes`] meshes.
+
+use bevy_ecs::prelude::*;
+use glam::{Vec3, Vec3A};
+
+use super::{Integrator, IntegratorOverride, drift, explicit_euler, kick};
+use crate::particles::{
+    ExternalForce, ExternalImpulse, Force, LinearVelocity, Mass, Nodes, Position,
+};
+use crate::quarantine::{QuarantineReason, Quarantined};
+use crate::schedule::{ForceSchedule, StepSystems, add_force_systems, add_systems};
+use crate::time::SubstepTime;
+use crate::{Plugin, SubstepSchedule};
+
+/// Integration, force clearing, impulses and the NaN quarantine of moving bodies. Part of the
+/// core: every other effect needs it.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct IntegratorPlugin;
+
+impl Plugin for IntegratorPlugin {
+    fn build(&self, world: &mut World) {
+        world.init_resource::<Integrator>();
+        add_force_systems(world, || clear_forces.in_set(StepSystems::ClearForces));
+        add_systems(
+            world,
+            SubstepSchedule,
+            (
+                (
+                    apply_impulses.run_if(any_with_component::<ExternalImpulse>),
+                    integrate_velocities,
+                )
+                    .chain()
+                    .in_set(StepSystems::IntegrateVelocities),
+                integrate_positions.in_set(StepSystems::IntegratePositions),
+                complete_stages
+                    .run_if(needs_stages)
+                    .in_set(StepSystems::CompleteStages),
+            ),
+        );
+    }
+}
+
+type Live = Without<Quarantined>;
+
+/// f ← external force, or zero.
+pub(crate) fn clear_forces(
+    mut plain: Query<&mut Force, (Without<ExternalForce>, Live)>,
+    mut external: Query<(&mut Force, &ExternalForce), Live>,
+    mut meshes: Query<&mut Nodes, Live>,
+) {
+    // Force is an accumulator nobody watches for changes; skipping the tick write keeps
+    // this pass at raw-loop speed.
+    for mut f in &mut plain {
+        f.bypass_change_detection().0 = Vec3::ZERO;
+    }
+    for (mut f, ext) in &mut external {
+        f.bypass_change_detection().0 = ext.0;
+    }
+    for mut nodes in &mut meshes {
+        nodes.bypass_change_detection().f.fill(Vec3A::ZERO);
+    }
+}
+
+/// Δv = J / m, then J ← 0 without marking it changed (so the next step sees no new impulse).
+pub(crate) fn apply_impulses(
+    mut bodies: Query<
+        (&mut LinearVelocity, &mut ExternalImpulse, &Mass),
+        (Changed<ExternalImpulse>, Live),
+    >,
+) {
+    for (mut v, mut j, m) in &mut bodies {
+        if j.0 != Vec3::ZERO {
+            v.0 += j.0 * m.inverse();
+            j.bypass_change_detection().0 = Vec3::ZERO;
+        }
+    }
+}
+
+/// The velocity half of a step; explicit Euler does its whole step here.
+#[inline]
+fn velocity_phase(method: Integrator, x: &mut Vec3A, v: &mut Vec3A, a: Vec3A, h: f32) {
+    match method {
+        Integrator::ExplicitEuler => (*x, *v) = explicit_euler(*x, *v, a, h),
+        Integrator::SymplecticEuler => *v = kick(*v, a, h),
+        Integrator::VelocityVerlet => *v = kick(*v, a, 0.5 * h),
+        Integrator::Rk4 => {}
+    }
+}
+
+/// The position half of a step.
+#[inline]
+fn position_phase(method: Integrator, x: &mut Vec3A, v: Vec3A, h: f32) {
+    if matches!(
+        method,
+        Integrator::SymplecticEuler | Integrator::VelocityVerlet
+    ) {
+        *x = drift(*x, v, h);
+    }
+}
+
+type BodyState<'a> = (
+    &'a mut Position,
+    &'a mut LinearVelocity,
+    &'a Force,
+    &'a Mass,
+);
+
+fn integrate_velocities(
+    global: Res<Integrator>,
+    time: Res<SubstepTime>,
+    mut bodies: Query<BodyState, (Without<IntegratorOverride>, Live)>,
+    mut overridden: Query<(BodyState, &IntegratorOverride), Live>,
+    mut meshes: Query<(&mut Nodes, Option<&IntegratorOverride>), Live>,
+) {
+    let h = time.h;
+    let method = *global;
+    if method == Integrator::SymplecticEuler {
+        // The common case, kept free of the position write so that only velocities tick.
+        for (_, mut v, f, m) in &mut bodies {
+            v.0 += (h * m.inverse()) * f.0;
+        }
+    } else if method != Integrator::Rk4 {
+        for (mut x, mut v, f, m) in &mut bodies {
+            body_velocity_phase(method, &mut x, &mut v, f, m, h);
+        }
+    }
+    for ((mut x, mut v, f, m), o) in &mut overridden {
+        body_velocity_phase(o.0, &mut x, &mut v, f, m, h);
+    }
+    for (mut nodes, o) in &mut meshes {
+        let method = o.map_or(method, |o| o.0);
+        let n = nodes.bypass_change_detection();
+        for i in 0..n.x.len() {
+            let a = n.f[i] * n.inv_mass[i];
+            velocity_phase(method, &mut n.x[i], &mut n.v[i], a, h);
+        }
+    }
+}
+
+fn body_velocity_phase(
+    method: Integrator,
+    x: &mut Mut<Position>,
+    v: &mut Mut<LinearVelocity>,
+    f: &Force,
+    m: &Mass,
+    h: f32,
+) {
+    let mut xa = Vec3A::from(x.0);
+    let mut va = Vec3A::from(v.0);
+    velocity_phase(method, &mut xa, &mut va, Vec3A::from(f.0) * m.inverse(), h);
+    if method == Integrator::ExplicitEuler {
+        x.0 = xa.into();
+    }
+    v.0 = va.into();
+}
+
+fn quarantine_non_finite(commands: &mut Commands, entity: Entity) {
+    commands.entity(entity).insert(Quarantined {
+        reason: QuarantineReason::NonFiniteState,
+    });
+}
+
+fn integrate_positions(
+    mut commands: Commands,
+    global: Res<Integrator>,
+    time: Res<SubstepTime>,
+    mut bodies: Query<
+        (
+            Entity,
+            &mut Position,
+            &LinearVelocity,
+            Option<&IntegratorOverride>,
+        ),
+        (With<Mass>, Live),
+    >,
+    mut meshes: Query<(Entity, &mut Nodes, Option<&IntegratorOverride>), Live>,
+) {
+    let h = time.h;
+    for (e, mut x, v, o) in &mut bodies {
+        let method = o.map_or(*global, |o| o.0);
+        let mut xa = Vec3A::from(x.0);
+        position_phase(method, &mut xa, v.0.into(), h);
+        if matches!(
+            method,
+            Integrator::SymplecticEuler | Integrator::VelocityVerlet
+        ) {
+            x.0 = xa.into();
+        }
+        if !(xa.is_finite() && v.0.is_finite()) {
+            quarantine_non_finite(&mut commands, e);
+        }
+    }
+    for (e, mut nodes, o) in &mut meshes {
+        let method = o.map_or(*global, |o| o.0);
+        let n = nodes.bypass_change_detection();
+        let mut finite = true;
+        for (x, v) in n.x.iter_mut().zip(&n.v) {
+            position_phase(method, x, *v, h);
+            finite &= x.is_finite() & v.is_finite();
+        }
+        if !finite {
+            quarantine_non_finite(&mut commands, e);
+        }
+    }
+}
+
+fn needs_stages(global: Res<Integrator>, overrides: Query<&IntegratorOverride>) -> bool {
+    global.is_multistage() || overrides.iter().any(|o| o.0.is_multistage())
+}
+
+/// RK4 bookkeeping for one particle: the start state and the weighted derivative sums.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Rk4Scratch {
+    x0: Vec3A,
+    v0: Vec3A,
+    sum_x: Vec3A,
+    sum_v: Vec3A,
+}
+
+impl Rk4Scratch {
+    const WEIGHT: [f32; 4] = [1.0, 2.0, 2.0, 1.0];
+    const OFFSET: [f32; 3] = [0.5, 0.5, 1.0];
+
+    /// Starts a step from (x₀, v₀).
+    #[must_use]
+    pub fn begin(x0: Vec3A, v0: Vec3A) -> Self {
+        Self {
+            x0,
+            v0,
+            ..Default::default()
+        }
+    }
+
+    /// Records stage `k`'s derivative (ẋ, v̇) = (`v`, `a`), both taken at stage `k`'s state,
+    /// and returns the state of stage k + 1, or the end-of-step state after stage 3.
+    #[must_use]
+    pub fn stage(&mut self, k: usize, v: Vec3A, a: Vec3A, h: f32) -> (Vec3A, Vec3A) {
+        let w = Self::WEIGHT[k & 3];
+        self.sum_x += w * v;
+        self.sum_v += w * a;
+        if k < 3 {
+            let c = Self::OFFSET[k] * h;
+            (self.x0 + c * v, self.v0 + c * a)
+        } else {
+            let s = h / 6.0;
+            (self.x0 + s * self.sum_x, self.v0 + s * self.sum_v)
+        }
+    }
+}
+
+/// Reused allocations of [`complete_stages`].
+#[derive(Default)]
+struct StageScratch {
+    bodies: Vec<(Entity, Rk4Scratch)>,
+    verlet: Vec<Entity>,
+    meshes: Vec<(Entity, Integrator, Vec<Rk4Scratch>)>,
+}
+
+type StageBody<'a> = (
+    Entity,
+    &'a mut Position,
+    &'a mut LinearVelocity,
+    &'a Force,
+    &'a Mass,
+    Option<&'a IntegratorOverride>,
+);
+
+/// Verlet's second kick and RK4's stages 2–4. Each extra force evaluation re-runs
+/// [`ForceSchedule`]: the same systems as the substep's force sets.
+fn complete_stages(
+    world: &mut World,
+    bodies: &mut QueryState<StageBody, Live>,
+    meshes: &mut QueryState<(Entity, &mut Nodes, Option<&IntegratorOverride>), Live>,
+    mut scratch: Local<StageScratch>,
+) {
+    let global = *world.resource::<Integrator>();
+    let h = world.resource::<SubstepTime>().h;
+    let StageScratch {
+        bodies: rk4,
+        verlet,
+        meshes: mesh_stages,
+    } = &mut *scratch;
+    rk4.clear();
+    verlet.clear();
+    mesh_stages.clear();
+
+    // Stage 1: RK4 bodies still sit at (x₀, v₀) with forces f(x₀, v₀).
+    for (e, mut x, mut v, f, m, o) in bodies.iter_mut(world) {
+        match o.map_or(global, |o| o.0) {
+            Integrator::Rk4 => {
+                let mut s = Rk4Scratch::begin(x.0.into(), v.0.into());
+                let (xs, vs) = s.stage(0, v.0.into(), Vec3A::from(f.0) * m.inverse(), h);
+                (x.0, v.0) = (xs.into(), vs.into());
+                rk4.push((e, s));
+            }
+            Integrator::VelocityVerlet => verlet.push(e),
+            _ => {}
+        }
+    }
+    for (e, mut nodes, o) in meshes.iter_mut(world) {
+        let method = o.map_or(global, |o| o.0);
+        if !method.is_multistage() {
+            continue;
+        }
+        let mut stages = Vec::new();
+        if method == Integrator::Rk4 {
+            let n = nodes.bypass_change_detection();
+            stages.reserve(n.x.len());
+            for i in 0..n.x.len() {
+                let mut s = Rk4Scratch::begin(n.x[i], n.v[i]);
+                (n.x[i], n.v[i]) = s.stage(0, n.v[i], n.f[i] * n.inv_mass[i], h);
+                stages.push(s);
+            }
+        }
+        mesh_stages.push((e, method, stages));
+    }
+    if rk4.is_empty() && verlet.is_empty() && mesh_stages.is_empty() {
+        return;
+    }
+
+    let _ = world.try_run_schedule(ForceSchedule);
+
+    // Verlet: v ← v½ + ½h a(x₁, v½).
+    for &e in verlet.iter() {
+        if let Ok((_, _, mut v, f, m, _)) = bodies.get_mut(world, e) {
+            v.0 += (0.5 * h * m.inverse()) * f.0;
+        }
+    }
+    for (e, method, _) in mesh_stages.iter() {
+        if *method == Integrator::VelocityVerlet
+            && let Ok((_, mut nodes, _)) = meshes.get_mut(world, *e)
+        {
+            let n = nodes.bypass_change_detection();
+            for i in 0..n.v.len() {
+                n.v[i] += (0.5 * h * n.inv_mass[i]) * n.f[i];
+            }
+        }
+    }
+
+    let any_rk4 = !rk4.is_empty() || mesh_stages.iter().any(|m| m.1 == Integrator::Rk4);
+    if !any_rk4 {
+        return;
+    }
+    for k in 1..4 {
+        for (e, s) in rk4.iter_mut() {
+            if let Ok((_, mut x, mut v, f, m, _)) = bodies.get_mut(world, *e) {
+                let (xs, vs) = s.stage(k, v.0.into(), Vec3A::from(f.0) * m.inverse(), h);
+                (x.0, v.0) = (xs.into(), vs.into());
+            }
+        }
+        for (e, method, stages) in mesh_stages.iter_mut() {
+            if *method != Integrator::Rk4 {
+                continue;
+            }
+            if let Ok((_, mut nodes, _)) = meshes.get_mut(world, *e) {
+                let n = nodes.bypass_change_detection();
+                for (i, s) in stages.iter_mut().enumerate() {
+                    (n.x[i], n.v[i]) = s.stage(k, n.v[i], n.f[i] * n.inv_mass[i], h);
+                }
+            }
+        }
+        if k < 3 {
+            let _ = world.try_run_schedule(ForceSchedule);
+        }
+    }
+
+    // RK4 bodies skipped the position phase, so check them here.
+    let mut bad = Vec::new();
+    for (e, _) in rk4.iter() {
+        if let Ok((_, x, v, ..)) = bodies.get(world, *e)
+            && !(x.0.is_finite() && v.0.is_finite())
+        {
+            bad.push(*e);
+        }
+    }
+    for (e, method, _) in mesh_stages.iter() {
+        if *method == Integrator::Rk4
+            && let Ok((_, nodes, _)) = meshes.get(world, *e)
+            && !nodes.is_finite()
+        {
+            bad.push(*e);
+        }
+    }
+    for e in bad {
+        world.entity_mut(e).insert(Quarantined {
+            reason: QuarantineReason::NonFiniteState,
+        });
+    }
+}

@@ -1,0 +1,173 @@
+//! Structure-of-arrays particles for meshes (ropes as one component, cloth, soft bodies).
+
+use bevy_ecs::prelude::*;
+use glam::{Vec3, Vec3A};
+
+use crate::error::{Error, Result, finite_vec};
+
+/// Many particles in one component, stored as parallel arrays so that force and integration
+/// loops stream through memory. Gravity, damping, every integrator and the NaN quarantine act
+/// on them exactly as on particle entities; springs act through a
+/// [`crate::springs::SpringNetwork`] on the same entity.
+///
+/// Units as for particles: positions in m, velocities in m/s, masses in kg, forces in N.
+#[derive(Component, Debug, Clone, Default, PartialEq)]
+pub struct Nodes {
+    pub(crate) x: Vec<Vec3A>,
+    pub(crate) v: Vec<Vec3A>,
+    pub(crate) f: Vec<Vec3A>,
+    /// m, or 0 for pinned nodes (as in [`crate::Mass`]).
+    pub(crate) mass: Vec<f32>,
+    pub(crate) inv_mass: Vec<f32>,
+}
+
+impl Nodes {
+    /// No nodes.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// No nodes, with room for `n`.
+    #[must_use]
+    pub fn with_capacity(n: usize) -> Self {
+        Self {
+            x: Vec::with_capacity(n),
+            v: Vec::with_capacity(n),
+            f: Vec::with_capacity(n),
+            mass: Vec::with_capacity(n),
+            inv_mass: Vec::with_capacity(n),
+        }
+    }
+
+    /// Adds a node at `x` (m) with velocity `v` (m/s) and mass `kg`; returns its index.
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`] or [`Error::InvalidMass`].
+    pub fn push(&mut self, x: Vec3, v: Vec3, kg: f32) -> Result<usize> {
+        let m = crate::Mass::new(kg)?;
+        self.push_raw(
+            finite_vec("node position", x)?,
+            finite_vec("node velocity", v)?,
+            m,
+        )
+    }
+
+    /// Adds a pinned node at `x` (m); returns its index.
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`].
+    pub fn push_pinned(&mut self, x: Vec3) -> Result<usize> {
+        self.push_raw(
+            finite_vec("node position", x)?,
+            Vec3::ZERO,
+            crate::Mass::PINNED,
+        )
+    }
+
+    fn push_raw(&mut self, x: Vec3, v: Vec3, m: crate::Mass) -> Result<usize> {
+        self.x.push(x.into());
+        self.v.push(v.into());
+        self.f.push(Vec3A::ZERO);
+        self.mass.push(m.force_scale());
+        self.inv_mass.push(m.inverse());
+        Ok(self.x.len() - 1)
+    }
+
+    fn check(&self, i: usize) -> Result<()> {
+        if i < self.x.len() {
+            Ok(())
+        } else {
+            Err(Error::IndexOutOfRange {
+                what: "node",
+                index: i,
+                len: self.x.len(),
+            })
+        }
+    }
+
+    /// Pins node `i` in place (infinite mass).
+    ///
+    /// # Errors
+    /// [`Error::IndexOutOfRange`].
+    pub fn pin(&mut self, i: usize) -> Result<()> {
+        self.check(i)?;
+        self.mass[i] = 0.0;
+        self.inv_mass[i] = 0.0;
+        self.v[i] = Vec3A::ZERO;
+        Ok(())
+    }
+
+    /// Moves node `i` to `x` (m).
+    ///
+    /// # Errors
+    /// [`Error::IndexOutOfRange`] or [`Error::NonFinite`].
+    pub fn set_position(&mut self, i: usize, x: Vec3) -> Result<()> {
+        self.check(i)?;
+        self.x[i] = finite_vec("node position", x)?.into();
+        Ok(())
+    }
+
+    /// Sets node `i`'s velocity (m/s).
+    ///
+    /// # Errors
+    /// [`Error::IndexOutOfRange`] or [`Error::NonFinite`].
+    pub fn set_velocity(&mut self, i: usize, v: Vec3) -> Result<()> {
+        self.check(i)?;
+        self.v[i] = finite_vec("node velocity", v)?.into();
+        Ok(())
+    }
+
+    /// Number of nodes.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// True when there are no nodes.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Positions (m).
+    #[must_use]
+    pub fn positions(&self) -> &[Vec3A] {
+        &self.x
+    }
+
+    /// Velocities (m/s).
+    #[must_use]
+    pub fn velocities(&self) -> &[Vec3A] {
+        &self.v
+    }
+
+    /// Forces of the last evaluation (N).
+    #[must_use]
+    pub fn forces(&self) -> &[Vec3A] {
+        &self.f
+    }
+
+    /// Inverse masses (1/kg), 0 for pinned nodes.
+    #[must_use]
+    pub fn inverse_masses(&self) -> &[f32] {
+        &self.inv_mass
+    }
+
+    /// Mass of node `i` (kg), infinite when pinned; `None` out of range.
+    #[must_use]
+    pub fn mass(&self, i: usize) -> Option<f32> {
+        let inv = *self.inv_mass.get(i)?;
+        Some(if inv == 0.0 {
+            f32::INFINITY
+        } else {
+            self.mass[i]
+        })
+    }
+
+    /// True when every position and velocity is finite.
+    #[must_use]
+    pub fn is_finite(&self) -> bool {
+        self.x.iter().all(|x| x.is_finite()) && self.v.iter().all(|v| v.is_finite())
+    }
+}

@@ -1,0 +1,83 @@
+//! NaN quarantine: a body whose state turns non-finite stops being simulated, is reported,
+//! and the rest of the world goes on.
+//!
+//! Two paths lead here:
+//! - **Bad input.** A component inserted directly with a non-finite or out-of-range value
+//!   (constructors can't be bypassed for [`crate::Mass`], but `Position(Vec3::NAN)` can be
+//!   written by hand) is caught by the component's insert hook.
+//! - **Blow-up.** A body whose position or velocity is non-finite after integration.
+//!
+//! Either way the entity gets [`Quarantined`], every physics system skips it (an archetype
+//! filter, so it costs nothing per body), a [`BodyQuarantined`] message is written, and
+//! [`crate::PhysicsDiagnostics`] counts it. Remove [`Quarantined`] after repairing the state
+//! to put the body back.
+
+use bevy_ecs::lifecycle::HookContext;
+use bevy_ecs::prelude::*;
+use bevy_ecs::world::DeferredWorld;
+
+use crate::diagnostics::PhysicsDiagnostics;
+use crate::error::Error;
+
+/// Why a body was taken out of the simulation.
+#[derive(Debug, Clone, PartialEq)]
+pub enum QuarantineReason {
+    /// Its position or velocity became NaN or infinite during a step.
+    NonFiniteState,
+    /// A component was inserted with an invalid value.
+    InvalidInput(Error),
+}
+
+/// Marks a body that is no longer simulated. See the module docs.
+#[derive(Component, Debug, Clone, PartialEq)]
+#[component(on_insert = report_quarantine)]
+pub struct Quarantined {
+    /// Why.
+    pub reason: QuarantineReason,
+}
+
+/// Written once for every body put into quarantine. Read it with
+/// `World::resource::<Messages<BodyQuarantined>>()` or a `MessageReader`; messages live for
+/// two `step_physics` / `advance_physics` calls.
+#[derive(Message, Debug, Clone, PartialEq)]
+pub struct BodyQuarantined {
+    /// The body.
+    pub entity: Entity,
+    /// Why.
+    pub reason: QuarantineReason,
+}
+
+fn report_quarantine(mut world: DeferredWorld, ctx: HookContext) {
+    let Some(reason) = world
+        .get::<Quarantined>(ctx.entity)
+        .map(|q| q.reason.clone())
+    else {
+        return;
+    };
+    if let Some(mut diag) = world.get_resource_mut::<PhysicsDiagnostics>() {
+        diag.quarantined_total += 1;
+        diag.last_quarantined = Some((ctx.entity, reason.clone()));
+    }
+    world.write_message(BodyQuarantined {
+        entity: ctx.entity,
+        reason,
+    });
+}
+
+/// A component whose value can be checked after a direct insert.
+pub(crate) trait Validate {
+    fn validate(&self) -> Result<(), Error>;
+}
+
+/// Insert hook shared by every validated component: quarantine on a bad value.
+pub(crate) fn validate_on_insert<T: Component + Validate>(
+    mut world: DeferredWorld,
+    ctx: HookContext,
+) {
+    let Some(Err(err)) = world.get::<T>(ctx.entity).map(Validate::validate) else {
+        return;
+    };
+    world.commands().entity(ctx.entity).insert(Quarantined {
+        reason: QuarantineReason::InvalidInput(err),
+    });
+}

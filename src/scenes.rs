@@ -1,0 +1,132 @@
+//! Scene builders shared by tests, examples and benchmarks, so that every figure is measured
+//! on the same scene that is tested.
+
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+
+use crate::error::Result;
+use crate::particles::{Gravity, ParticleBundle, Tracer, VelocityField};
+use crate::springs::{Chain, ChainBuilder, ClothBuilder, Spring};
+use crate::{Integrator, PhysicsPlugins, PhysicsTime, PhysicsWorldExt};
+
+/// A world with every plugin, the given step and integrator, and gravity `g`.
+///
+/// # Errors
+/// As [`PhysicsTime::new`] and [`Gravity::new`].
+pub fn world_with(dt: f32, substeps: u32, integrator: Integrator, g: Vec3) -> Result<World> {
+    let mut world = World::new();
+    world.insert_resource(PhysicsTime::new(dt, substeps)?);
+    world.add_physics(PhysicsPlugins);
+    world.insert_resource(integrator);
+    world.insert_resource(Gravity::new(g)?);
+    Ok(world)
+}
+
+/// A 1-D undamped or damped oscillator: a pinned anchor at the origin and a particle of mass
+/// `m` (kg) at (x0, 0, 0) on a zero-length spring of stiffness `k` (N/m), damping `c`
+/// (N·s/m). Returns the moving particle. Closed form for c = 0:
+/// x(t) = x0 cos(ωt), ω = √(k/m).
+///
+/// # Errors
+/// Constructor errors for bad values.
+pub fn oscillator(world: &mut World, m: f32, k: f32, c: f32, x0: f32) -> Result<Entity> {
+    let anchor = world.spawn(ParticleBundle::pinned(Vec3::ZERO)?).id();
+    let body = world
+        .spawn(ParticleBundle::new(Vec3::new(x0, 0.0, 0.0), Vec3::ZERO, m)?)
+        .id();
+    Spring::from_hooke(anchor, body, 0.0, k, c)?.spawn(world)?;
+    Ok(body)
+}
+
+/// `n` free particles of 1 kg on a jittered cube lattice with small velocities; the same
+/// values every call (a fixed integer hash, no RNG state).
+///
+/// # Errors
+/// None in practice; constructor errors are forwarded.
+pub fn particle_cloud(world: &mut World, n: usize) -> Result<()> {
+    let side = (n as f32).cbrt().ceil() as usize;
+    let mut batch = Vec::with_capacity(n);
+    for i in 0..n {
+        let (a, b, c) = (i % side, (i / side) % side, i / (side * side));
+        let x = Vec3::new(a as f32, b as f32 + 10.0, c as f32) * 0.5 + jitter(i) * 0.1;
+        batch.push(ParticleBundle::new(x, jitter(i + n), 1.0)?);
+    }
+    world.spawn_batch(batch);
+    Ok(())
+}
+
+/// A deterministic value in [−1, 1]³ from an index.
+#[must_use]
+pub fn jitter(i: usize) -> Vec3 {
+    let h = |s: u64| {
+        let mut z = (i as u64)
+            .wrapping_add(s)
+            .wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+    };
+    Vec3::new(h(1), h(2), h(3))
+}
+
+/// The perf report's cloth: `n` × `n` nodes 1 cm apart, structural, shear and bend springs
+/// (about 6 n² springs).
+///
+/// # Errors
+/// As [`ClothBuilder::build`].
+pub fn cloth(world: &mut World, n: usize) -> Result<Entity> {
+    ClothBuilder::new(Vec3::new(-0.5, 2.0, -0.5), n, n, 1.0 / n as f32).spawn(world)
+}
+
+/// The showcase's entities.
+#[derive(Debug, Clone)]
+pub struct Showcase {
+    /// A rope pinned at one end, starting horizontal so it swings.
+    pub rope: Chain,
+    /// A hair strand with bending springs.
+    pub hair: Chain,
+    /// Tracers in a vortex.
+    pub tracers: Vec<Entity>,
+    /// Free particles thrown upward.
+    pub particles: Vec<Entity>,
+}
+
+/// The README demo: a swinging rope, a hair strand, tracers in a vortex and thrown particles.
+///
+/// # Errors
+/// Constructor errors (none with these values).
+pub fn showcase(world: &mut World) -> Result<Showcase> {
+    let rope = ChainBuilder::rope(Vec3::new(-2.0, 3.0, 0.0), Vec3::new(0.0, 3.0, 0.0), 21)
+        .stiffness(4000.0)
+        .damping(0.5)
+        .spawn(world)?;
+    let hair =
+        ChainBuilder::hair(Vec3::new(1.0, 3.0, 0.0), Vec3::new(1.8, 2.6, 0.0), 12).spawn(world)?;
+    world.spawn(VelocityField::vortex(
+        Vec3::new(3.5, 1.5, 0.0),
+        Vec3::Z,
+        2.0,
+    )?);
+    let tracers = (0..24)
+        .map(|i| {
+            let r = 0.2 + 0.05 * i as f32;
+            let a = i as f32 * 0.7;
+            let x = Vec3::new(3.5 + r * a.cos(), 1.5 + r * a.sin(), 0.0);
+            Ok(world.spawn((crate::Position::try_new(x)?, Tracer)).id())
+        })
+        .collect::<Result<Vec<_>>>()?;
+    let particles = (0..8)
+        .map(|i| {
+            let v = Vec3::new(1.0 + 0.3 * i as f32, 6.0 + 0.2 * i as f32, 0.0);
+            Ok(world
+                .spawn(ParticleBundle::new(Vec3::new(-4.0, 0.0, 0.0), v, 0.5)?)
+                .id())
+        })
+        .collect::<Result<Vec<_>>>()?;
+    Ok(Showcase {
+        rope,
+        hair,
+        tracers,
+        particles,
+    })
+}

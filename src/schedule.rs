@@ -1,0 +1,210 @@
+//! The schedules and system sets. **This is the only file that chains run order.**
+//!
+//! ```text
+//! PhysicsSchedule            one fixed step of length dt
+//!   PhysicsSystems::Prepare    drop broken springs, derived data
+//!   PhysicsSystems::Step       runs SubstepSchedule `substeps` times, h = dt / substeps
+//!   PhysicsSystems::Finish     diagnostics
+//!
+//! SubstepSchedule            one substep of length h
+//!   StepSystems::ClearForces        f ← external force (or 0)
+//!   StepSystems::ApplyForces        gravity, damping, springs, fields
+//!   StepSystems::AccumulateTorque   forces at points → torque (rigid bodies)
+//!   StepSystems::IntegrateVelocities
+//!   StepSystems::SolveConstraints   contacts and joints act on velocities here
+//!   StepSystems::IntegratePositions
+//!   StepSystems::CompleteStages     extra force evaluations of Verlet and RK4
+//!   StepSystems::Renormalize        unit quaternions
+//!
+//! ForceSchedule              the three force sets alone, re-run at stage states
+//! ```
+//!
+//! Effect plugins only place systems `.in_set(...)`; force systems go through
+//! [`add_force_systems`] so that the substep and the stage re-evaluations run the same code.
+//! Every schedule is built with ambiguity detection set to error, and runs single-threaded so
+//! that the same inputs give bit-identical results.
+
+use bevy_ecs::prelude::*;
+use bevy_ecs::schedule::{
+    IntoScheduleConfigs, LogLevel, ScheduleBuildSettings, ScheduleLabel, SingleThreadedExecutor,
+};
+use bevy_ecs::system::ScheduleSystem;
+
+/// One fixed physics step. Run it with [`crate::PhysicsWorldExt::step_physics`].
+#[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
+pub struct PhysicsSchedule;
+
+/// One substep; run `substeps` times per [`PhysicsSchedule`].
+#[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
+pub struct SubstepSchedule;
+
+/// The force sets alone, re-run by multi-stage integrators at stage states.
+#[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
+pub struct ForceSchedule;
+
+/// The sets of [`PhysicsSchedule`], in run order.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PhysicsSystems {
+    /// Derived data and bookkeeping before the substeps.
+    Prepare,
+    /// Runs the substeps.
+    Step,
+    /// Diagnostics after the substeps.
+    Finish,
+}
+
+/// The sets of [`SubstepSchedule`] (and, for the first three, [`ForceSchedule`]), in run order.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum StepSystems {
+    /// Force accumulators are reset to the persistent external force.
+    ClearForces,
+    /// Every force effect adds into the accumulators.
+    ApplyForces,
+    /// Forces applied at points become torques on rigid bodies.
+    AccumulateTorque,
+    /// Velocities advance from forces (and impulses).
+    IntegrateVelocities,
+    /// Contacts and joints correct velocities.
+    SolveConstraints,
+    /// Positions advance from velocities; tracers are advected.
+    IntegratePositions,
+    /// Verlet's second kick and RK4's stages, which re-run [`ForceSchedule`].
+    CompleteStages,
+    /// Orientations are renormalised to unit quaternions.
+    Renormalize,
+}
+
+impl StepSystems {
+    /// Every set in run order.
+    pub const ORDER: [StepSystems; 8] = [
+        StepSystems::ClearForces,
+        StepSystems::ApplyForces,
+        StepSystems::AccumulateTorque,
+        StepSystems::IntegrateVelocities,
+        StepSystems::SolveConstraints,
+        StepSystems::IntegratePositions,
+        StepSystems::CompleteStages,
+        StepSystems::Renormalize,
+    ];
+}
+
+/// The force effects inside [`StepSystems::ApplyForces`], in run order. Forces add into
+/// the same accumulators, and floating-point addition is not associative, so a fixed order
+/// is what makes results bit-identical from run to run.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ForceSystems {
+    /// Uniform gravity.
+    Gravity,
+    /// Drag and damping.
+    Damping,
+    /// Spring forces.
+    Springs,
+    /// Elastic forces of deformable meshes.
+    Elasticity,
+    /// Forces added by game code, last.
+    User,
+}
+
+/// Timing probes between the step sets; probe k runs just before `StepSystems::ORDER[k]`.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub(crate) struct ProbeSystems(pub u8);
+
+fn new_schedule(label: impl ScheduleLabel) -> Schedule {
+    let mut schedule = Schedule::new(label);
+    schedule.set_executor(SingleThreadedExecutor::new());
+    schedule.set_build_settings(ScheduleBuildSettings {
+        ambiguity_detection: LogLevel::Error,
+        ..Default::default()
+    });
+    schedule
+}
+
+/// Creates the three schedules with their sets chained. Called once by the core plugin.
+pub(crate) fn init_schedules(world: &mut World) {
+    let mut physics = new_schedule(PhysicsSchedule);
+    physics.configure_sets(
+        (
+            PhysicsSystems::Prepare,
+            PhysicsSystems::Step,
+            PhysicsSystems::Finish,
+        )
+            .chain(),
+    );
+
+    let mut substep = new_schedule(SubstepSchedule);
+    substep.configure_sets(
+        (
+            ProbeSystems(0),
+            StepSystems::ClearForces,
+            ProbeSystems(1),
+            StepSystems::ApplyForces,
+            ProbeSystems(2),
+            StepSystems::AccumulateTorque,
+            ProbeSystems(3),
+            StepSystems::IntegrateVelocities,
+            ProbeSystems(4),
+            StepSystems::SolveConstraints,
+            ProbeSystems(5),
+            StepSystems::IntegratePositions,
+            ProbeSystems(6),
+            StepSystems::CompleteStages,
+            ProbeSystems(7),
+            StepSystems::Renormalize,
+            ProbeSystems(8),
+        )
+            .chain(),
+    );
+
+    let mut forces = new_schedule(ForceSchedule);
+    for schedule in [&mut substep, &mut forces] {
+        schedule.configure_sets(
+            (
+                ForceSystems::Gravity,
+                ForceSystems::Damping,
+                ForceSystems::Springs,
+                ForceSystems::Elasticity,
+                ForceSystems::User,
+            )
+                .chain()
+                .in_set(StepSystems::ApplyForces),
+        );
+    }
+    forces.configure_sets(
+        (
+            StepSystems::ClearForces,
+            StepSystems::ApplyForces,
+            StepSystems::AccumulateTorque,
+        )
+            .chain(),
+    );
+
+    let mut schedules = world.get_resource_or_init::<Schedules>();
+    schedules.insert(physics);
+    schedules.insert(substep);
+    schedules.insert(forces);
+}
+
+/// Adds force systems to both the substep and the stage re-evaluation schedule.
+///
+/// `systems` is called once per schedule, so each schedule owns its own system state. Place
+/// the systems in [`StepSystems::ClearForces`], one of the [`ForceSystems`] or
+/// [`StepSystems::AccumulateTorque`].
+pub fn add_force_systems<M, S>(world: &mut World, systems: impl Fn() -> S)
+where
+    S: IntoScheduleConfigs<ScheduleSystem, M>,
+{
+    let mut schedules = world.get_resource_or_init::<Schedules>();
+    schedules.add_systems(SubstepSchedule, systems());
+    schedules.add_systems(ForceSchedule, systems());
+}
+
+/// Adds systems to one schedule.
+pub fn add_systems<M>(
+    world: &mut World,
+    label: impl ScheduleLabel,
+    systems: impl IntoScheduleConfigs<ScheduleSystem, M>,
+) {
+    world
+        .get_resource_or_init::<Schedules>()
+        .add_systems(label, systems);
+}

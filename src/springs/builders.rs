@@ -1,0 +1,260 @@
+//! Builders for ropes, hair strands and cloth.
+
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+
+use super::{Spring, SpringNetwork};
+use crate::error::{Error, Result, finite_vec, non_negative, positive};
+use crate::particles::{Nodes, ParticleBundle};
+
+/// A chain of particle entities joined by springs: a rope, or with bending springs (node i to
+/// node i + 2) a hair strand.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChainBuilder {
+    start: Vec3,
+    end: Vec3,
+    nodes: usize,
+    node_mass: f32,
+    stiffness: f32,
+    damping: f32,
+    bend_stiffness: f32,
+    pin_start: bool,
+}
+
+/// The entities of a spawned chain, from the start node to the end node.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Chain {
+    /// Particle entities, start first.
+    pub nodes: Vec<Entity>,
+    /// Springs between neighbours: `springs[i]` joins `nodes[i]` and `nodes[i + 1]`.
+    pub springs: Vec<Entity>,
+    /// Bending springs: `bend_springs[i]` joins `nodes[i]` and `nodes[i + 2]`.
+    pub bend_springs: Vec<Entity>,
+}
+
+impl ChainBuilder {
+    /// A straight rope of `nodes` particles from `start` to `end` (m), pinned at the start,
+    /// 0.1 kg per node, k = 2000 N/m and c = 1 N·s/m per segment.
+    #[must_use]
+    pub fn rope(start: Vec3, end: Vec3, nodes: usize) -> Self {
+        Self {
+            start,
+            end,
+            nodes,
+            node_mass: 0.1,
+            stiffness: 2000.0,
+            damping: 1.0,
+            bend_stiffness: 0.0,
+            pin_start: true,
+        }
+    }
+
+    /// A hair strand: a light rope with bending springs (k_bend = 20 N/m) so it keeps its
+    /// shape against gravity a little.
+    #[must_use]
+    pub fn hair(root: Vec3, tip: Vec3, nodes: usize) -> Self {
+        Self {
+            node_mass: 0.01,
+            stiffness: 500.0,
+            damping: 0.05,
+            bend_stiffness: 20.0,
+            ..Self::rope(root, tip, nodes)
+        }
+    }
+
+    /// Mass of each free node (kg).
+    #[must_use]
+    pub fn node_mass(mut self, kg: f32) -> Self {
+        self.node_mass = kg;
+        self
+    }
+
+    /// Segment stiffness k (N/m).
+    #[must_use]
+    pub fn stiffness(mut self, k: f32) -> Self {
+        self.stiffness = k;
+        self
+    }
+
+    /// Segment damping c (N·s/m).
+    #[must_use]
+    pub fn damping(mut self, c: f32) -> Self {
+        self.damping = c;
+        self
+    }
+
+    /// Bending stiffness (N/m) of the springs that skip one node; 0 for none.
+    #[must_use]
+    pub fn bending(mut self, k: f32) -> Self {
+        self.bend_stiffness = k;
+        self
+    }
+
+    /// Whether the start node is pinned.
+    #[must_use]
+    pub fn pin_start(mut self, pin: bool) -> Self {
+        self.pin_start = pin;
+        self
+    }
+
+    /// Spawns the particles and springs.
+    ///
+    /// # Errors
+    /// [`Error::TooFew`] for fewer than 2 nodes, and the errors of the particle and spring
+    /// constructors for bad values. Nothing is spawned on error.
+    pub fn spawn(&self, world: &mut World) -> Result<Chain> {
+        if self.nodes < 2 {
+            return Err(Error::TooFew {
+                what: "chain nodes",
+                min: 2,
+                got: self.nodes,
+            });
+        }
+        let start = finite_vec("chain start", self.start)?;
+        let end = finite_vec("chain end", self.end)?;
+        let k = non_negative("spring stiffness", self.stiffness)?;
+        let c = non_negative("spring damping", self.damping)?;
+        let kb = non_negative("bending stiffness", self.bend_stiffness)?;
+        let step = (end - start) / (self.nodes - 1) as f32;
+        let mut bundles = Vec::with_capacity(self.nodes);
+        for i in 0..self.nodes {
+            let x = start + step * i as f32;
+            bundles.push(if i == 0 && self.pin_start {
+                ParticleBundle::pinned(x)?
+            } else {
+                ParticleBundle::new(x, Vec3::ZERO, self.node_mass)?
+            });
+        }
+        let nodes: Vec<Entity> = bundles.into_iter().map(|b| world.spawn(b).id()).collect();
+        let seg = step.length();
+        let mut chain = Chain {
+            nodes,
+            ..Default::default()
+        };
+        for w in chain.nodes.windows(2) {
+            let s = Spring::from_hooke(w[0], w[1], seg, k, c)?;
+            chain.springs.push(world.spawn(s).id());
+        }
+        if kb > 0.0 {
+            for w in chain.nodes.windows(3) {
+                let s = Spring::from_hooke(w[0], w[2], 2.0 * seg, kb, 0.0)?;
+                chain.bend_springs.push(world.spawn(s).id());
+            }
+        }
+        Ok(chain)
+    }
+}
+
+/// A rectangular cloth as one [`Nodes`] + [`SpringNetwork`]: structural springs to the four
+/// neighbours, shear springs on both diagonals and bending springs that skip one node.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClothBuilder {
+    origin: Vec3,
+    nx: usize,
+    nz: usize,
+    spacing: f32,
+    node_mass: f32,
+    k_structural: f32,
+    k_shear: f32,
+    k_bend: f32,
+    damping: f32,
+    pin_corners: bool,
+}
+
+impl ClothBuilder {
+    /// A horizontal `nx` × `nz` cloth in the x–z plane starting at `origin`, nodes `spacing`
+    /// m apart, 0.01 kg per node, k = 500 / 300 / 50 N/m (structural / shear / bend),
+    /// c = 0.05 N·s/m, pinned at the two corners of its first row.
+    #[must_use]
+    pub fn new(origin: Vec3, nx: usize, nz: usize, spacing: f32) -> Self {
+        Self {
+            origin,
+            nx,
+            nz,
+            spacing,
+            node_mass: 0.01,
+            k_structural: 500.0,
+            k_shear: 300.0,
+            k_bend: 50.0,
+            damping: 0.05,
+            pin_corners: true,
+        }
+    }
+
+    /// Stiffnesses (N/m) of the structural, shear and bending springs.
+    #[must_use]
+    pub fn stiffness(mut self, structural: f32, shear: f32, bend: f32) -> Self {
+        (self.k_structural, self.k_shear, self.k_bend) = (structural, shear, bend);
+        self
+    }
+
+    /// Whether the first row's two corners are pinned.
+    #[must_use]
+    pub fn pin_corners(mut self, pin: bool) -> Self {
+        self.pin_corners = pin;
+        self
+    }
+
+    /// Builds the arrays.
+    ///
+    /// # Errors
+    /// [`Error::TooFew`] for a side under 3 nodes; errors of the node and spring constructors.
+    pub fn build(&self) -> Result<(Nodes, SpringNetwork)> {
+        for n in [self.nx, self.nz] {
+            if n < 3 {
+                return Err(Error::TooFew {
+                    what: "cloth nodes per side",
+                    min: 3,
+                    got: n,
+                });
+            }
+        }
+        let s = positive("cloth spacing", self.spacing)?;
+        let (nx, nz) = (self.nx, self.nz);
+        let mut nodes = Nodes::with_capacity(nx * nz);
+        for j in 0..nz {
+            for i in 0..nx {
+                let x = self.origin + Vec3::new(i as f32 * s, 0.0, j as f32 * s);
+                nodes.push(x, Vec3::ZERO, self.node_mass)?;
+            }
+        }
+        if self.pin_corners {
+            nodes.pin(0)?;
+            nodes.pin(nx - 1)?;
+        }
+        let id = |i: usize, j: usize| j * nx + i;
+        let mut net = SpringNetwork::new();
+        let c = self.damping;
+        let diag = s * std::f32::consts::SQRT_2;
+        for j in 0..nz {
+            for i in 0..nx {
+                if i + 1 < nx {
+                    net.push(id(i, j), id(i + 1, j), s, self.k_structural, c)?;
+                }
+                if j + 1 < nz {
+                    net.push(id(i, j), id(i, j + 1), s, self.k_structural, c)?;
+                }
+                if i + 1 < nx && j + 1 < nz {
+                    net.push(id(i, j), id(i + 1, j + 1), diag, self.k_shear, c)?;
+                    net.push(id(i + 1, j), id(i, j + 1), diag, self.k_shear, c)?;
+                }
+                if i + 2 < nx {
+                    net.push(id(i, j), id(i + 2, j), 2.0 * s, self.k_bend, c)?;
+                }
+                if j + 2 < nz {
+                    net.push(id(i, j), id(i, j + 2), 2.0 * s, self.k_bend, c)?;
+                }
+            }
+        }
+        Ok((nodes, net))
+    }
+
+    /// Builds and spawns the cloth as one entity.
+    ///
+    /// # Errors
+    /// As [`ClothBuilder::build`].
+    pub fn spawn(&self, world: &mut World) -> Result<Entity> {
+        let (nodes, net) = self.build()?;
+        Ok(world.spawn((nodes, net)).id())
+    }
+}

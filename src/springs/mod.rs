@@ -1,0 +1,299 @@
+//! Damped springs: ropes, hair and cloth.
+//!
+//! The lecture's force on endpoint p of a spring (p, q) with rest length r:
+//!
+//! ```text
+//! f_p = [ k_s (|x_q − x_p| / r − 1) + k_d ((v_q − v_p)·(x_q − x_p)) / (r |x_q − x_p|) ] d̂,   f_q = −f_p
+//! ```
+//!
+//! with d̂ = (x_q − x_p)/|x_q − x_p|. Here k_s is a force per unit strain (N) and k_d a force per
+//! unit strain rate (N·s). Dividing by r gives the Hooke form that hooke stores and that also
+//! works for zero-length springs:
+//!
+//! ```text
+//! f_p = [ k (l − r) + c (v_q − v_p)·d̂ ] d̂,   k = k_s / r (N/m),   c = k_d / r (N·s/m)
+//! ```
+//!
+//! [`Spring::new`] takes the lecture's (k_s, k_d); [`Spring::from_hooke`] takes (k, c) and
+//! allows r = 0. When the endpoints coincide the direction is undefined and the force is
+//! zero (for r = 0 that is also the limit). The potential energy is ½ k (l − r)².
+//!
+//! Two representations share [`spring_force`]:
+//! - [`Spring`], one entity per spring between two body entities: flexible, for ropes,
+//!   hair and gameplay tethers.
+//! - [`SpringNetwork`] with [`crate::Nodes`] on one entity: arrays of springs over arrays of
+//!   nodes, for cloth and anything with thousands of springs. It streams through memory
+//!   instead of looking entities up.
+
+mod builders;
+mod plugin;
+
+pub use builders::{Chain, ChainBuilder, ClothBuilder};
+pub use plugin::SpringPlugin;
+
+use bevy_ecs::lifecycle::HookContext;
+use bevy_ecs::prelude::*;
+use bevy_ecs::world::DeferredWorld;
+use glam::Vec3A;
+
+use crate::error::{Error, Result, non_negative, positive};
+use crate::particles::{Nodes, Position};
+use crate::quarantine::{QuarantineReason, Quarantined};
+
+/// The damped spring force on endpoint a (N); the force on b is its negative.
+///
+/// `rest` in m, `k` in N/m, `c` in N·s/m (the Hooke form; see the module docs for the
+/// lecture's strain form). Returns zero when the endpoints coincide.
+#[must_use]
+#[inline]
+pub fn spring_force(
+    xa: Vec3A,
+    xb: Vec3A,
+    va: Vec3A,
+    vb: Vec3A,
+    rest: f32,
+    k: f32,
+    c: f32,
+) -> Vec3A {
+    let d = xb - xa;
+    let l2 = d.length_squared();
+    // Also false for NaN, so a broken endpoint yields no force rather than NaN.
+    if !(l2 > 1e-30) {
+        return Vec3A::ZERO;
+    }
+    let l = l2.sqrt();
+    let dir = d / l;
+    (k * (l - rest) + c * (vb - va).dot(dir)) * dir
+}
+
+/// Potential energy ½ k (l − r)² of a spring (J).
+#[must_use]
+#[inline]
+pub fn spring_energy(xa: Vec3A, xb: Vec3A, rest: f32, k: f32) -> f32 {
+    let s = (xb - xa).length() - rest;
+    0.5 * k * s * s
+}
+
+/// A spring entity between bodies `a` and `b` (entities with a [`Position`]).
+///
+/// Build it with [`Spring::new`] or [`Spring::from_hooke`] and spawn it like any component.
+/// If an endpoint is despawned, the spring is despawned at the next step.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = validate_spring)]
+pub struct Spring {
+    a: Entity,
+    b: Entity,
+    rest_length: f32,
+    stiffness: f32,
+    damping: f32,
+}
+
+impl Spring {
+    /// The lecture's spring: rest length `r` (m, > 0), `ks` (N per unit strain) and `kd`
+    /// (N·s per unit strain rate).
+    ///
+    /// # Errors
+    /// [`Error::SelfSpring`], [`Error::NotPositive`] for r ≤ 0, [`Error::Negative`] or
+    /// [`Error::NonFinite`] for bad coefficients.
+    pub fn new(a: Entity, b: Entity, r: f32, ks: f32, kd: f32) -> Result<Self> {
+        let r = positive("rest length", r)?;
+        let ks = non_negative("spring stiffness", ks)?;
+        let kd = non_negative("spring damping", kd)?;
+        Self::from_hooke(a, b, r, ks / r, kd / r)
+    }
+
+    /// A spring in Hooke form: rest length `r` (m, ≥ 0), stiffness `k` (N/m), damping `c`
+    /// (N·s/m).
+    ///
+    /// # Errors
+    /// [`Error::SelfSpring`], [`Error::Negative`] or [`Error::NonFinite`].
+    pub fn from_hooke(a: Entity, b: Entity, r: f32, k: f32, c: f32) -> Result<Self> {
+        if a == b {
+            return Err(Error::SelfSpring(a));
+        }
+        Ok(Self {
+            a,
+            b,
+            rest_length: non_negative("rest length", r)?,
+            stiffness: non_negative("spring stiffness", k)?,
+            damping: non_negative("spring damping", c)?,
+        })
+    }
+
+    /// Spawns this spring after checking that both endpoints are bodies.
+    ///
+    /// # Errors
+    /// [`Error::MissingEntity`] if an endpoint does not exist or has no [`Position`].
+    pub fn spawn(self, world: &mut World) -> Result<Entity> {
+        for e in [self.a, self.b] {
+            if world.get::<Position>(e).is_none() {
+                return Err(Error::MissingEntity(e));
+            }
+        }
+        Ok(world.spawn(self).id())
+    }
+
+    /// First endpoint.
+    #[must_use]
+    pub fn a(&self) -> Entity {
+        self.a
+    }
+    /// Second endpoint.
+    #[must_use]
+    pub fn b(&self) -> Entity {
+        self.b
+    }
+    /// Rest length r (m).
+    #[must_use]
+    pub fn rest_length(&self) -> f32 {
+        self.rest_length
+    }
+    /// Stiffness k (N/m).
+    #[must_use]
+    pub fn stiffness(&self) -> f32 {
+        self.stiffness
+    }
+    /// Damping c (N·s/m).
+    #[must_use]
+    pub fn damping(&self) -> f32 {
+        self.damping
+    }
+
+    fn check(&self) -> Result<()> {
+        Self::from_hooke(
+            self.a,
+            self.b,
+            self.rest_length,
+            self.stiffness,
+            self.damping,
+        )
+        .map(|_| ())
+    }
+}
+
+fn validate_spring(mut world: DeferredWorld, ctx: HookContext) {
+    let Some(spring) = world.get::<Spring>(ctx.entity).copied() else {
+        return;
+    };
+    let mut result = spring.check();
+    for e in [spring.a, spring.b] {
+        if result.is_ok() && world.get::<Position>(e).is_none() {
+            result = Err(Error::MissingEntity(e));
+        }
+    }
+    if let Err(err) = result {
+        world.commands().entity(ctx.entity).insert(Quarantined {
+            reason: QuarantineReason::InvalidInput(err),
+        });
+    }
+}
+
+/// Springs between the [`Nodes`] of the same entity, as parallel arrays (Hooke form).
+#[derive(Component, Debug, Clone, Default, PartialEq)]
+pub struct SpringNetwork {
+    pub(crate) ends: Vec<[u32; 2]>,
+    pub(crate) rest: Vec<f32>,
+    pub(crate) k: Vec<f32>,
+    pub(crate) c: Vec<f32>,
+    /// Largest node index used, so one comparison per step proves every index in range.
+    pub(crate) max_index: u32,
+}
+
+impl SpringNetwork {
+    /// No springs.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds a spring between nodes `a` and `b` (Hooke form: r in m, k in N/m, c in N·s/m).
+    ///
+    /// # Errors
+    /// [`Error::IndexOutOfRange`] when `a == b` or an index exceeds `u32`,
+    /// [`Error::Negative`] or [`Error::NonFinite`] for bad coefficients.
+    pub fn push(&mut self, a: usize, b: usize, r: f32, k: f32, c: f32) -> Result<usize> {
+        if a == b {
+            return Err(Error::IndexOutOfRange {
+                what: "second spring endpoint (equal to the first)",
+                index: b,
+                len: a,
+            });
+        }
+        let (ia, ib) = match (u32::try_from(a), u32::try_from(b)) {
+            (Ok(ia), Ok(ib)) => (ia, ib),
+            _ => {
+                return Err(Error::IndexOutOfRange {
+                    what: "spring endpoint",
+                    index: a.max(b),
+                    len: u32::MAX as usize,
+                });
+            }
+        };
+        let (r, k, c) = (
+            non_negative("rest length", r)?,
+            non_negative("spring stiffness", k)?,
+            non_negative("spring damping", c)?,
+        );
+        self.ends.push([ia, ib]);
+        self.rest.push(r);
+        self.k.push(k);
+        self.c.push(c);
+        self.max_index = self.max_index.max(ia).max(ib);
+        Ok(self.ends.len() - 1)
+    }
+
+    /// Number of springs.
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// True when there are no springs.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.ends.is_empty()
+    }
+
+    /// Node index pairs.
+    #[must_use]
+    pub fn ends(&self) -> &[[u32; 2]] {
+        &self.ends
+    }
+
+    /// True when every endpoint indexes into `nodes`.
+    #[must_use]
+    pub fn fits(&self, nodes: &Nodes) -> bool {
+        self.is_empty() || (self.max_index as usize) < nodes.len()
+    }
+
+    /// Potential energy of all springs over `nodes` (J).
+    #[must_use]
+    pub fn energy(&self, nodes: &Nodes) -> f32 {
+        if !self.fits(nodes) {
+            return 0.0;
+        }
+        let x = nodes.positions();
+        (0..self.len())
+            .map(|i| {
+                let [a, b] = self.ends[i];
+                spring_energy(x[a as usize], x[b as usize], self.rest[i], self.k[i])
+            })
+            .sum()
+    }
+
+    /// Adds every spring force into `nodes`' accumulators. Returns false (and does nothing)
+    /// when an index is out of range.
+    pub fn accumulate(&self, nodes: &mut Nodes) -> bool {
+        if !self.fits(nodes) {
+            return false;
+        }
+        let Nodes { x, v, f, .. } = nodes;
+        for (i, &[a, b]) in self.ends.iter().enumerate() {
+            let (a, b) = (a as usize, b as usize);
+            let fa = spring_force(x[a], x[b], v[a], v[b], self.rest[i], self.k[i], self.c[i]);
+            f[a] += fa;
+            f[b] -= fa;
+        }
+        true
+    }
+}

@@ -1,0 +1,210 @@
+//! Fixed time step, substeps and the frame accumulator.
+//!
+//! A physics step has a fixed length `dt` (s) split into `substeps` substeps of length
+//! h = dt / substeps. A game's frames have whatever length they have: [`PhysicsTime`] keeps an
+//! accumulator, and [`crate::PhysicsWorldExt::advance_physics`] runs as many whole steps as
+//! fit, at most `max_steps_per_frame`, so that one slow frame cannot make the next one slower
+//! still (the "spiral of death"). Time beyond the cap is dropped and reported.
+
+use bevy_ecs::prelude::*;
+
+use crate::error::{Error, Result};
+use crate::schedule::SubstepSchedule;
+
+/// The fixed step and the simulation clock.
+#[derive(Resource, Debug, Clone)]
+pub struct PhysicsTime {
+    dt: f32,
+    substeps: u32,
+    max_steps_per_frame: u32,
+    accumulator: f32,
+    elapsed: f64,
+    steps: u64,
+}
+
+impl Default for PhysicsTime {
+    /// 60 Hz, one substep, at most 4 steps per frame.
+    fn default() -> Self {
+        Self {
+            dt: 1.0 / 60.0,
+            substeps: 1,
+            max_steps_per_frame: 4,
+            accumulator: 0.0,
+            elapsed: 0.0,
+            steps: 0,
+        }
+    }
+}
+
+impl PhysicsTime {
+    /// A fixed step of `dt` seconds split into `substeps` substeps.
+    ///
+    /// # Errors
+    /// [`Error::InvalidTimeStep`] if `dt` is not positive and finite, [`Error::ZeroSubsteps`]
+    /// if `substeps` is 0.
+    pub fn new(dt: f32, substeps: u32) -> Result<Self> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err(Error::InvalidTimeStep(dt));
+        }
+        if substeps == 0 {
+            return Err(Error::ZeroSubsteps);
+        }
+        Ok(Self {
+            dt,
+            substeps,
+            ..Default::default()
+        })
+    }
+
+    /// Caps how many steps one call to `advance_physics` may run (at least 1).
+    ///
+    /// # Errors
+    /// [`Error::TooFew`] for 0.
+    pub fn with_max_steps_per_frame(mut self, max: u32) -> Result<Self> {
+        if max == 0 {
+            return Err(Error::TooFew {
+                what: "steps per frame",
+                min: 1,
+                got: 0,
+            });
+        }
+        self.max_steps_per_frame = max;
+        Ok(self)
+    }
+
+    /// Step length (s).
+    #[must_use]
+    pub fn dt(&self) -> f32 {
+        self.dt
+    }
+
+    /// Substeps per step.
+    #[must_use]
+    pub fn substeps(&self) -> u32 {
+        self.substeps
+    }
+
+    /// Substep length h = dt / substeps (s).
+    #[must_use]
+    pub fn substep_dt(&self) -> f32 {
+        self.dt / self.substeps as f32
+    }
+
+    /// Simulated time (s), counted in f64 so that long sessions keep their precision.
+    #[must_use]
+    pub fn elapsed(&self) -> f64 {
+        self.elapsed
+    }
+
+    /// Whole steps taken.
+    #[must_use]
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Steps allowed per frame.
+    #[must_use]
+    pub fn max_steps_per_frame(&self) -> u32 {
+        self.max_steps_per_frame
+    }
+
+    /// Frame time not yet simulated (s); always less than `dt` after a frame.
+    #[must_use]
+    pub fn accumulator(&self) -> f32 {
+        self.accumulator
+    }
+
+    /// Adds frame time and returns how many steps to run and how much time was dropped.
+    pub(crate) fn take_frame(&mut self, frame_dt: f32) -> Result<(u32, f32)> {
+        if !(frame_dt.is_finite() && frame_dt >= 0.0) {
+            return Err(Error::InvalidTimeStep(frame_dt));
+        }
+        self.accumulator += frame_dt;
+        let wanted = (self.accumulator / self.dt).floor();
+        let steps = wanted.min(self.max_steps_per_frame as f32) as u32;
+        self.accumulator -= steps as f32 * self.dt;
+        let mut dropped = 0.0;
+        if self.accumulator >= self.dt {
+            // Keep the fractional remainder so the next frame stays in phase; drop the rest.
+            let keep = self.accumulator % self.dt;
+            dropped = self.accumulator - keep;
+            self.accumulator = keep;
+        }
+        Ok((steps, dropped))
+    }
+}
+
+/// The current substep: its length and start time. Read by time-dependent effects.
+#[derive(Resource, Debug, Clone, Copy, Default)]
+pub struct SubstepTime {
+    /// Substep length h (s).
+    pub h: f32,
+    /// Simulated time at the start of this substep (s).
+    pub t: f32,
+}
+
+/// What one call to `advance_physics` did.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FrameReport {
+    /// Whole steps run.
+    pub steps: u32,
+    /// Frame time thrown away because the step cap was reached (s).
+    pub dropped: f32,
+}
+
+/// Runs the substep schedule `substeps` times. The only system in `PhysicsSystems::Step`.
+pub(crate) fn run_substeps(world: &mut World) {
+    let Some(time) = world.get_resource::<PhysicsTime>() else {
+        return;
+    };
+    let (n, h, t0) = (time.substeps, time.substep_dt(), time.elapsed);
+    for i in 0..n {
+        let t = (t0 + f64::from(h) * f64::from(i)) as f32;
+        world.insert_resource(SubstepTime { h, t });
+        // The core plugin creates this schedule; a missing one means a user removed it.
+        let _ = world.try_run_schedule(SubstepSchedule);
+    }
+    if let Some(mut time) = world.get_resource_mut::<PhysicsTime>() {
+        time.elapsed += f64::from(time.dt);
+        time.steps += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bad_steps_are_typed_errors() {
+        assert_eq!(
+            PhysicsTime::new(0.0, 1).unwrap_err(),
+            Error::InvalidTimeStep(0.0)
+        );
+        assert!(matches!(
+            PhysicsTime::new(f32::NAN, 1),
+            Err(Error::InvalidTimeStep(_))
+        ));
+        assert!(matches!(
+            PhysicsTime::new(-0.1, 1),
+            Err(Error::InvalidTimeStep(_))
+        ));
+        assert_eq!(PhysicsTime::new(0.01, 0).unwrap_err(), Error::ZeroSubsteps);
+        assert!(PhysicsTime::default().with_max_steps_per_frame(0).is_err());
+    }
+
+    #[test]
+    fn accumulator_caps_steps_and_keeps_phase() {
+        let mut t = PhysicsTime::new(0.01, 1)
+            .unwrap()
+            .with_max_steps_per_frame(3)
+            .unwrap();
+        assert_eq!(t.take_frame(0.025).unwrap().0, 2);
+        assert!((t.accumulator() - 0.005).abs() < 1e-6);
+        let (steps, dropped) = t.take_frame(1.0).unwrap();
+        assert_eq!(steps, 3);
+        assert!(dropped > 0.96 && dropped < 0.98, "dropped {dropped}");
+        assert!(t.accumulator() < t.dt());
+        assert!(t.take_frame(f32::NAN).is_err());
+        assert!(t.take_frame(-1.0).is_err());
+    }
+}

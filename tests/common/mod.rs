@@ -1,0 +1,30 @@
+//! Helpers shared by the integration tests.
+#![allow(dead_code)]
+
+use bevy_ecs::prelude::*;
+use hooke::prelude::*;
+use hooke::scenes;
+
+pub const TWO_PI: f32 = std::f32::consts::TAU;
+
+/// An oscillator world: m = 1, k = 4π² (period 1 s), x0 = 1, no gravity.
+pub fn oscillator(dt: f32, integrator: Integrator, c: f32) -> (World, Entity) {
+    let mut world = scenes::world_with(dt, 1, integrator, Vec3::ZERO).unwrap();
+    let body = scenes::oscillator(&mut world, 1.0, TWO_PI * TWO_PI, c, 1.0).unwrap();
+    (world, body)
+}
+
+pub fn x(world: &World, e: Entity) -> Vec3 {
+    world.get::<Position>(e).unwrap().0
+}
+
+pub fn v(world: &World, e: Entity) -> Vec3 {
+    world.get::<LinearVelocity>(e).unwrap().0
+}
+
+/// Energy ½v² + ½kx² of the unit oscillator, in f64.
+pub fn oscillator_energy(world: &World, e: Entity) -> f64 {
+    let (x, v) = (f64::from(x(world, e).x), f64::from(v(world, e).x));
+    let k = std::f64::consts::TAU.powi(2);
+    0.5 * v * v + 0.5 * k * x * x
+}
