@@ -117,7 +117,7 @@ fn integrate_velocities(
     if method == Integrator::SymplecticEuler {
         // The common case, kept free of the position write so that only velocities tick.
         for (_, mut v, f, m) in &mut bodies {
-            v.0 += (h * m.inverse()) * f.0;
+            v.0 = kick(v.0.into(), Vec3A::from(f.0) * m.inverse(), h).into();
         }
     } else if method != Integrator::Rk4 {
         for (mut x, mut v, f, m) in &mut bodies {
@@ -159,6 +159,13 @@ fn quarantine_non_finite(commands: &mut Commands, entity: Entity) {
         reason: QuarantineReason::NonFiniteState,
     });
 }
+
+type PositionPhase<'a> = (
+    Entity,
+    &'a mut Position,
+    &'a LinearVelocity,
+    Option<&'a IntegratorOverride>,
+);
 
 fn integrate_positions(
     mut commands: Commands,
@@ -323,7 +330,7 @@ fn complete_stages(
     // Verlet: v ← v½ + ½h a(x₁, v½).
     for &e in verlet.iter() {
         if let Ok((_, _, mut v, f, m, _)) = bodies.get_mut(world, e) {
-            v.0 += (0.5 * h * m.inverse()) * f.0;
+            v.0 = kick(v.0.into(), Vec3A::from(f.0) * m.inverse(), 0.5 * h).into();
         }
     }
     for (e, method, _) in mesh_stages.iter() {
@@ -332,7 +339,7 @@ fn complete_stages(
         {
             let n = nodes.bypass_change_detection();
             for i in 0..n.v.len() {
-                n.v[i] += (0.5 * h * n.inv_mass[i]) * n.f[i];
+                n.v[i] = kick(n.v[i], n.f[i] * n.inv_mass[i], 0.5 * h);
             }
         }
     }

@@ -95,12 +95,16 @@ impl Plugin for VelocityFieldPlugin {
     }
 }
 
+/// Tracers are massless; `Without<Mass>` also proves to the scheduler that this query never
+/// aliases the particle integrator's positions.
+type TracerFilter = (With<Tracer>, Without<Mass>, Live);
+
 fn advect_tracers(
     mut commands: Commands,
     scheme: Res<Advection>,
     time: Res<SubstepTime>,
     fields: Query<&VelocityField>,
-    mut tracers: Query<(Entity, &mut Position), (With<Tracer>, Without<Mass>, Live)>,
+    mut tracers: Query<(Entity, &mut Position), TracerFilter>,
 ) {
     if fields.is_empty() {
         return;

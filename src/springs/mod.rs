@@ -57,8 +57,8 @@ pub fn spring_force(
 ) -> Vec3A {
     let d = xb - xa;
     let l2 = d.length_squared();
-    // Also false for NaN, so a broken endpoint yields no force rather than NaN.
-    if !(l2 > 1e-30) {
+    // NaN compares as not greater, so a broken endpoint yields no force rather than NaN.
+    if l2.partial_cmp(&1e-30) != Some(core::cmp::Ordering::Greater) {
         return Vec3A::ZERO;
     }
     let l = l2.sqrt();
