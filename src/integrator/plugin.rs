@@ -171,15 +171,7 @@ fn integrate_positions(
     mut commands: Commands,
     global: Res<Integrator>,
     time: Res<SubstepTime>,
-    mut bodies: Query<
-        (
-            Entity,
-            &mut Position,
-            &LinearVelocity,
-            Option<&IntegratorOverride>,
-        ),
-        (With<Mass>, Live),
-    >,
+    mut bodies: Query<PositionPhase, (With<Mass>, Live)>,
     mut meshes: Query<(Entity, &mut Nodes, Option<&IntegratorOverride>), Live>,
 ) {
     let h = time.h;
