@@ -61,7 +61,7 @@ use bevy_ecs::prelude::*;
 
 pub use diagnostics::{DiagnosticsSettings, PhysicsDiagnostics};
 pub use error::{Error, Result};
-pub use integrator::{Integrator, IntegratorOverride, IntegratorPlugin};
+pub use integrator::{ConstraintsActive, Integrator, IntegratorOverride, IntegratorPlugin};
 pub use particles::{
     Advection, DampingPlugin, ExternalForce, ExternalImpulse, Force, Gravity, GravityPlugin,
     GravityScale, LinearDamping, LinearVelocity, Mass, Nodes, ParticleBundle, Position, Tracer,

@@ -7,8 +7,8 @@
 //!   PhysicsSystems::Finish     diagnostics
 //!
 //! SubstepSchedule            one substep of length h
-//!   StepSystems::ClearForces        f ← external force (or 0)
-//!   StepSystems::ApplyForces        gravity, damping, springs, fields
+//!   StepSystems::ClearForces        f ← constant forces: external + m g s
+//!   StepSystems::ApplyForces        damping, springs, elasticity, user forces
 //!   StepSystems::AccumulateTorque   forces at points → torque (rigid bodies)
 //!   StepSystems::IntegrateVelocities
 //!   StepSystems::SolveConstraints   contacts and joints act on velocities here
@@ -56,9 +56,9 @@ pub enum PhysicsSystems {
 /// The sets of [`SubstepSchedule`] (and, for the first three, [`ForceSchedule`]), in run order.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum StepSystems {
-    /// Force accumulators are reset to the persistent external force.
+    /// Force accumulators start at the constant forces: external force plus gravity.
     ClearForces,
-    /// Every force effect adds into the accumulators.
+    /// Every state-dependent force effect adds into the accumulators.
     ApplyForces,
     /// Forces applied at points become torques on rigid bodies.
     AccumulateTorque,
@@ -93,8 +93,6 @@ impl StepSystems {
 /// is what makes results bit-identical from run to run.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum ForceSystems {
-    /// Uniform gravity.
-    Gravity,
     /// Drag and damping.
     Damping,
     /// Spring forces.
@@ -109,11 +107,15 @@ pub enum ForceSystems {
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub(crate) struct ProbeSystems(pub u8);
 
-fn new_schedule(label: impl ScheduleLabel) -> Schedule {
+/// `sync_points: false` leaves deferred commands (only quarantines use them in the step
+/// schedules) to the end of each run, which is before the next substep or stage reads them,
+/// and saves a sync system per commands-using system.
+fn new_schedule(label: impl ScheduleLabel, sync_points: bool) -> Schedule {
     let mut schedule = Schedule::new(label);
     schedule.set_executor(SingleThreadedExecutor::new());
     schedule.set_build_settings(ScheduleBuildSettings {
         ambiguity_detection: LogLevel::Error,
+        auto_insert_apply_deferred: sync_points,
         ..Default::default()
     });
     schedule
@@ -121,7 +123,7 @@ fn new_schedule(label: impl ScheduleLabel) -> Schedule {
 
 /// Creates the three schedules with their sets chained. Called once by the core plugin.
 pub(crate) fn init_schedules(world: &mut World) {
-    let mut physics = new_schedule(PhysicsSchedule);
+    let mut physics = new_schedule(PhysicsSchedule, true);
     physics.configure_sets(
         (
             PhysicsSystems::Prepare,
@@ -131,7 +133,7 @@ pub(crate) fn init_schedules(world: &mut World) {
             .chain(),
     );
 
-    let mut substep = new_schedule(SubstepSchedule);
+    let mut substep = new_schedule(SubstepSchedule, false);
     substep.configure_sets(
         (
             ProbeSystems(0),
@@ -155,11 +157,10 @@ pub(crate) fn init_schedules(world: &mut World) {
             .chain(),
     );
 
-    let mut forces = new_schedule(ForceSchedule);
+    let mut forces = new_schedule(ForceSchedule, false);
     for schedule in [&mut substep, &mut forces] {
         schedule.configure_sets(
             (
-                ForceSystems::Gravity,
                 ForceSystems::Damping,
                 ForceSystems::Springs,
                 ForceSystems::Elasticity,

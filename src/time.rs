@@ -9,6 +9,7 @@
 use bevy_ecs::prelude::*;
 
 use crate::error::{Error, Result};
+use crate::particles::{Mass, Nodes, Tracer};
 use crate::schedule::SubstepSchedule;
 
 /// The fixed step and the simulation clock.
@@ -152,18 +153,29 @@ pub struct FrameReport {
     pub dropped: f32,
 }
 
+/// Anything the substeps could move.
+type AnyBody = Or<(With<Mass>, With<Nodes>, With<Tracer>)>;
+
 /// Runs the substep schedule `substeps` times. The only system in `PhysicsSystems::Step`.
-pub(crate) fn run_substeps(world: &mut World) {
+/// A world without a single body only advances its clock.
+pub(crate) fn run_substeps(world: &mut World, bodies: &mut QueryState<(), AnyBody>) {
     let Some(time) = world.get_resource::<PhysicsTime>() else {
         return;
     };
+    let empty = bodies.iter(world).next().is_none();
     let (n, h, t0) = (time.substeps, time.substep_dt(), time.elapsed);
-    for i in 0..n {
-        let t = (t0 + f64::from(h) * f64::from(i)) as f32;
-        world.insert_resource(SubstepTime { h, t });
-        // The core plugin creates this schedule; a missing one means a user removed it.
-        let _ = world.try_run_schedule(SubstepSchedule);
-    }
+    // One lookup of the schedule for all substeps. The core plugin creates it; a missing
+    // one means a user removed it, and the step then does nothing.
+    let _ = world.try_schedule_scope(SubstepSchedule, |world, schedule| {
+        if empty {
+            return;
+        }
+        for i in 0..n {
+            let t = (t0 + f64::from(h) * f64::from(i)) as f32;
+            *world.resource_mut::<SubstepTime>() = SubstepTime { h, t };
+            schedule.run(world);
+        }
+    });
     if let Some(mut time) = world.get_resource_mut::<PhysicsTime>() {
         time.elapsed += f64::from(time.dt);
         time.steps += 1;

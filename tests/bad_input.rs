@@ -190,10 +190,13 @@ fn quarantine_reason(world: &World, e: Entity) -> Option<QuarantineReason> {
 fn directly_inserted_bad_components_are_quarantined_by_hooks() {
     let mut world = world();
     let bad_pos = world
-        .spawn((Position(Vec3::NAN), Mass::new(1.0).unwrap()))
+        .spawn((Position::from(Vec3::NAN), Mass::new(1.0).unwrap()))
         .id();
     let bad_vel = world
-        .spawn((LinearVelocity(Vec3::INFINITY), Mass::new(1.0).unwrap()))
+        .spawn((
+            LinearVelocity::from(Vec3::INFINITY),
+            Mass::new(1.0).unwrap(),
+        ))
         .id();
     let bad_damp = world
         .spawn((
@@ -285,7 +288,7 @@ fn non_finite_state_mid_step_is_quarantined_reported_and_contained() {
     world.step_physics();
     // Game code writes NaN through a mutable borrow: no hook sees it.
     let victim = chain.nodes[2];
-    world.get_mut::<LinearVelocity>(victim).unwrap().0 = Vec3::NAN;
+    world.get_mut::<LinearVelocity>(victim).unwrap().0 = Vec3::NAN.into();
     world.step_physics();
     assert_eq!(
         quarantine_reason(&world, victim),
@@ -312,8 +315,8 @@ fn non_finite_state_mid_step_is_quarantined_reported_and_contained() {
     }
     assert!(x(&world, other).y < -1.0);
     // Repairing the state and lifting the quarantine puts the body back.
-    world.get_mut::<LinearVelocity>(victim).unwrap().0 = Vec3::ZERO;
-    world.get_mut::<Position>(victim).unwrap().0 = Vec3::new(0.66, 0.0, 0.0);
+    world.get_mut::<LinearVelocity>(victim).unwrap().0 = Vec3::ZERO.into();
+    world.get_mut::<Position>(victim).unwrap().0 = Vec3::new(0.66, 0.0, 0.0).into();
     world.entity_mut(victim).remove::<Quarantined>();
     world.step_physics();
     assert!(v(&world, victim).y < 0.0);
@@ -326,10 +329,10 @@ fn nan_from_a_custom_field_quarantines_only_the_tracer() {
         if x.x > 0.5 { Vec3::NAN } else { Vec3::X }
     }));
     let doomed = world
-        .spawn((Position(Vec3::new(1.0, 0.0, 0.0)), Tracer))
+        .spawn((Position::from(Vec3::new(1.0, 0.0, 0.0)), Tracer))
         .id();
     let fine = world
-        .spawn((Position(Vec3::new(-5.0, 0.0, 0.0)), Tracer))
+        .spawn((Position::from(Vec3::new(-5.0, 0.0, 0.0)), Tracer))
         .id();
     world.step_physics();
     world.step_physics();

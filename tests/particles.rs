@@ -70,7 +70,7 @@ fn vortex_radius_after(advection: Advection, steps: usize) -> f32 {
     world.insert_resource(advection);
     world.spawn(VelocityField::vortex(Vec3::ZERO, Vec3::Z, 2.0).unwrap());
     let tracer = world
-        .spawn((Position(Vec3::new(1.0, 0.0, 0.0)), Tracer))
+        .spawn((Position::from(Vec3::new(1.0, 0.0, 0.0)), Tracer))
         .id();
     for _ in 0..steps {
         world.step_physics();
@@ -103,7 +103,7 @@ fn tracers_feel_the_sum_of_fields_and_custom_fields_see_time() {
     let mut world = scenes::world_with(0.1, 1, Integrator::SymplecticEuler, Vec3::ZERO).unwrap();
     world.spawn(VelocityField::uniform(Vec3::X).unwrap());
     world.spawn(VelocityField::custom(|_, t| Vec3::new(0.0, t, 0.0)));
-    let tracer = world.spawn((Position(Vec3::ZERO), Tracer)).id();
+    let tracer = world.spawn((Position::from(Vec3::ZERO), Tracer)).id();
     world.insert_resource(Advection::Rk4);
     for _ in 0..10 {
         world.step_physics();
@@ -131,7 +131,7 @@ fn external_force_persists_and_is_never_wiped() {
         world.get::<ExternalForce>(e).unwrap().0,
         Vec3::new(10.0, 0.0, 0.0)
     );
-    assert_eq!(world.get::<Force>(e).unwrap().0, Vec3::new(10.0, 0.0, 0.0));
+    assert_eq!(world.get::<Force>(e).unwrap().0, Vec3A::new(10.0, 0.0, 0.0));
 }
 
 #[test]
@@ -181,7 +181,7 @@ fn gravity_scale_and_pinned_bodies() {
             ExternalForce(Vec3::X),
         ))
         .id();
-    world.get_mut::<LinearVelocity>(kinematic).unwrap().0 = Vec3::X;
+    world.get_mut::<LinearVelocity>(kinematic).unwrap().0 = Vec3::X.into();
     for _ in 0..100 {
         world.step_physics();
     }

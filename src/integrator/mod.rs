@@ -32,7 +32,7 @@
 
 mod plugin;
 
-pub use plugin::{IntegratorPlugin, Rk4Scratch};
+pub use plugin::{ConstraintsActive, IntegratorPlugin, Rk4Scratch};
 
 use bevy_ecs::prelude::*;
 use glam::Vec3A;

@@ -4,7 +4,7 @@ use bevy_ecs::prelude::*;
 use glam::Vec3A;
 
 use super::fields::{Advection, Gravity, VelocityField};
-use super::{Force, GravityScale, LinearDamping, LinearVelocity, Mass, Nodes, Position, Tracer};
+use super::{Force, LinearDamping, LinearVelocity, Mass, Position, Tracer};
 use crate::Plugin;
 use crate::integrator::{advect_euler, advect_midpoint, advect_rk4};
 use crate::quarantine::{QuarantineReason, Quarantined};
@@ -13,48 +13,16 @@ use crate::time::SubstepTime;
 
 type Live = Without<Quarantined>;
 
-/// Uniform gravity, f = m g s. Runs only while some body has a [`Mass`] or [`Nodes`].
+/// Uniform gravity, f = m g s: installs the [`Gravity`] resource. Gravity is a constant
+/// force, so the core's force-clearing pass writes it into each accumulator (see
+/// [`crate::schedule::StepSystems::ClearForces`]); this plugin adds no system, and a world
+/// without it has no gravity at all.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct GravityPlugin;
 
 impl Plugin for GravityPlugin {
     fn build(&self, world: &mut World) {
         world.init_resource::<Gravity>();
-        add_force_systems(world, || {
-            apply_gravity
-                .run_if(any_massive_body)
-                .in_set(ForceSystems::Gravity)
-        });
-    }
-}
-
-/// True while a particle or mesh exists: the condition of every mass-proportional force.
-pub(crate) fn any_massive_body(p: Query<(), With<Mass>>, m: Query<(), With<Nodes>>) -> bool {
-    !(p.is_empty() && m.is_empty())
-}
-
-fn apply_gravity(
-    gravity: Res<Gravity>,
-    mut plain: Query<(&mut Force, &Mass), (Without<GravityScale>, Live)>,
-    mut scaled: Query<(&mut Force, &Mass, &GravityScale), Live>,
-    mut meshes: Query<&mut Nodes, Live>,
-) {
-    let g = gravity.get();
-    if g == glam::Vec3::ZERO {
-        return;
-    }
-    for (mut f, m) in &mut plain {
-        f.bypass_change_detection().0 += m.force_scale() * g;
-    }
-    for (mut f, m, s) in &mut scaled {
-        f.bypass_change_detection().0 += (m.force_scale() * s.0) * g;
-    }
-    let g = Vec3A::from(g);
-    for mut nodes in &mut meshes {
-        let n = nodes.bypass_change_detection();
-        for (f, m) in n.f.iter_mut().zip(&n.mass) {
-            *f += *m * g;
-        }
     }
 }
 
@@ -112,14 +80,14 @@ fn advect_tracers(
     let (t, h) = (time.t, time.h);
     let u = |x: Vec3A, t: f32| fields.iter().map(|f| f.velocity(x, t)).sum::<Vec3A>();
     for (e, mut p) in &mut tracers {
-        let x = Vec3A::from(p.0);
+        let x = p.0;
         let x = match *scheme {
             Advection::Euler => advect_euler(x, t, h, u),
             Advection::Midpoint => advect_midpoint(x, t, h, u),
             Advection::Rk4 => advect_rk4(x, t, h, u),
         };
         if x.is_finite() {
-            p.0 = x.into();
+            p.0 = x;
         } else {
             commands.entity(e).insert(Quarantined {
                 reason: QuarantineReason::NonFiniteState,

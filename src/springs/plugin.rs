@@ -48,10 +48,10 @@ fn apply_spring_forces(
             continue;
         };
         let f = spring_force(
-            xa.0.into(),
-            xb.0.into(),
-            va.0.into(),
-            vb.0.into(),
+            xa.0,
+            xb.0,
+            va.0,
+            vb.0,
             s.rest_length,
             s.stiffness,
             s.damping,
@@ -59,7 +59,6 @@ fn apply_spring_forces(
         if !f.is_finite() {
             continue;
         }
-        let f = glam::Vec3::from(f);
         if let Ok(mut fa) = forces.get_mut(s.a) {
             fa.bypass_change_detection().0 += f;
         }

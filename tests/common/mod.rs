@@ -15,11 +15,11 @@ pub fn oscillator(dt: f32, integrator: Integrator, c: f32) -> (World, Entity) {
 }
 
 pub fn x(world: &World, e: Entity) -> Vec3 {
-    world.get::<Position>(e).unwrap().0
+    world.get::<Position>(e).unwrap().get()
 }
 
 pub fn v(world: &World, e: Entity) -> Vec3 {
-    world.get::<LinearVelocity>(e).unwrap().0
+    world.get::<LinearVelocity>(e).unwrap().get()
 }
 
 /// Energy ½v² + ½kx² of the unit oscillator, in f64.
