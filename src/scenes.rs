@@ -98,7 +98,8 @@ pub struct Showcase {
 pub fn showcase(world: &mut World) -> Result<Showcase> {
     let rope = ChainBuilder::rope(Vec3::new(-2.0, 3.0, 0.0), Vec3::new(0.0, 3.0, 0.0), 21)
         .stiffness(4000.0)
-        .damping(0.5)
+        .damping(2.0)
+        .bending(40.0)
         .spawn(world)?;
     let hair =
         ChainBuilder::hair(Vec3::new(1.0, 3.0, 0.0), Vec3::new(1.8, 2.6, 0.0), 12).spawn(world)?;

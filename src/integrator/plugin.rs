@@ -305,6 +305,7 @@ impl Rk4Scratch {
 
     /// Starts a step from (x₀, v₀).
     #[must_use]
+    #[inline]
     pub fn begin(x0: Vec3A, v0: Vec3A) -> Self {
         Self {
             x0,
@@ -316,6 +317,7 @@ impl Rk4Scratch {
     /// Records stage `k`'s derivative (ẋ, v̇) = (`v`, `a`), both taken at stage `k`'s state,
     /// and returns the state of stage k + 1, or the end-of-step state after stage 3.
     #[must_use]
+    #[inline]
     pub fn stage(&mut self, k: usize, v: Vec3A, a: Vec3A, h: f32) -> (Vec3A, Vec3A) {
         let w = Self::WEIGHT[k & 3];
         self.sum_x += w * v;
