@@ -322,7 +322,7 @@ fn accuracy_dial(cfg: &Config) {
         let mut count = 0u32;
         move || {
             count += 1;
-            if count % 60 == 0 {
+            if count.is_multiple_of(60) {
                 world.get_mut::<Nodes>(e).unwrap().clone_from(&start);
             }
             world.step_physics();

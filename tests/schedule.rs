@@ -121,7 +121,10 @@ fn diagnostics_report_energy_counts_and_set_timings() {
     assert_eq!(c.tracers, scene.tracers.len());
     assert_eq!(
         c.springs,
-        scene.rope.springs.len() + scene.hair.springs.len() + scene.hair.bend_springs.len()
+        scene.rope.springs.len()
+            + scene.rope.bend_springs.len()
+            + scene.hair.springs.len()
+            + scene.hair.bend_springs.len()
     );
     assert_eq!((c.meshes, c.mesh_nodes), (1, 64));
     assert!(c.mesh_springs > 0);
