@@ -1,7 +1,9 @@
 //! What the last step did: energies, momentum, counts and where the time went.
 //!
 //! Energies are in J, momentum in kg·m/s, times in wall-clock durations.
-//! - kinetic T = Σ ½ m |v|² over particles and mesh nodes (pinned bodies excluded);
+//! - kinetic T = Σ ½ m |v|² over particles and mesh nodes (pinned bodies excluded), plus
+//!   Σ ½ ω·L over rigid bodies;
+//! - angular momentum about the origin Σ x × m v + L;
 //! - gravitational U_g = −Σ m g·x (zero at the origin);
 //! - spring U_s = Σ ½ k (l − r)²;
 //! - linear momentum P = Σ m v.
@@ -17,10 +19,11 @@ use glam::{DVec3, Vec3};
 
 use crate::particles::{Gravity, LinearVelocity, Mass, Nodes, Position, Tracer};
 use crate::quarantine::{QuarantineReason, Quarantined};
+use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, rotational_energy};
 use crate::schedule::{
     PhysicsSchedule, PhysicsSystems, ProbeSystems, StepSystems, SubstepSchedule, add_systems,
 };
-use crate::springs::{Spring, SpringNetwork, spring_energy};
+use crate::springs::{Endpoint, Spring, SpringNetwork, anchor_state, spring_energy};
 
 /// How many things of each kind the world holds (quarantined ones counted apart).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -37,6 +40,8 @@ pub struct BodyCounts {
     pub mesh_nodes: usize,
     /// Springs over all spring networks.
     pub mesh_springs: usize,
+    /// Rigid bodies with finite or infinite inertia (dynamic and kinematic).
+    pub rigid_bodies: usize,
     /// Entities currently quarantined.
     pub quarantined: usize,
 }
@@ -44,8 +49,12 @@ pub struct BodyCounts {
 /// Diagnostics of the last step. A resource.
 #[derive(Resource, Debug, Clone, Default)]
 pub struct PhysicsDiagnostics {
-    /// Kinetic energy (J).
+    /// Kinetic energy, translational plus rotational (J).
     pub kinetic_energy: f64,
+    /// The rotational part of the kinetic energy, Σ ½ ω·L (J).
+    pub rotational_energy: f64,
+    /// Total angular momentum about the world origin, Σ x × m v + L (kg·m²/s).
+    pub angular_momentum: Vec3,
     /// Gravitational potential energy relative to the origin (J).
     pub gravitational_energy: f64,
     /// Elastic energy stored in springs (J).
@@ -168,7 +177,8 @@ fn measure_energy(
     bodies: Query<(&Position, &LinearVelocity, &Mass), Live>,
     meshes: Query<(&Nodes, Option<&SpringNetwork>), Live>,
     springs: Query<&Spring, Live>,
-    states: Query<&Position, Live>,
+    states: Query<Endpoint, Live>,
+    rotating: Query<(&AngularVelocity, &AngularMomentum, &Inertia), Live>,
     tracers: Query<(), (With<Tracer>, Live)>,
     quarantined: Query<(), With<Quarantined>>,
 ) {
@@ -203,12 +213,34 @@ fn measure_energy(
     for s in &springs {
         counts.springs += 1;
         if let (Ok(a), Ok(b)) = (states.get(s.a()), states.get(s.b())) {
-            us += f64::from(spring_energy(a.0, b.0, s.rest_length(), s.stiffness()));
+            let (anchor_a, anchor_b) = s.anchors();
+            let (pa, _, _) = anchor_state(a, anchor_a);
+            let (pb, _, _) = anchor_state(b, anchor_b);
+            us += f64::from(spring_energy(pa, pb, s.rest_length(), s.stiffness()));
         }
     }
+    // Rotation: T_rot = ½ ω·L; angular momentum about the origin Σ (x × m v) + L.
+    let mut t_rot = 0.0f64;
+    let mut l_total = DVec3::ZERO;
+    for (x, v, m) in &bodies {
+        if !m.is_pinned() {
+            l_total += Vec3::from(x.0)
+                .as_dvec3()
+                .cross(f64::from(m.value()) * Vec3::from(v.0).as_dvec3());
+        }
+    }
+    for (w, l, inertia) in &rotating {
+        if !inertia.is_infinite() {
+            t_rot += f64::from(rotational_energy(w.0, l.0));
+            l_total += Vec3::from(l.0).as_dvec3();
+        }
+    }
+    counts.rigid_bodies = rotating.iter().count();
     counts.tracers = tracers.iter().count();
     counts.quarantined = quarantined.iter().count();
-    diag.kinetic_energy = t;
+    diag.kinetic_energy = t + t_rot;
+    diag.rotational_energy = t_rot;
+    diag.angular_momentum = l_total.as_vec3();
     diag.gravitational_energy = u;
     diag.spring_energy = us;
     diag.linear_momentum = p.as_vec3();

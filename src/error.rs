@@ -58,6 +58,9 @@ pub enum Error {
         /// The count given.
         got: usize,
     },
+    /// A shape has no volume (flat, open or a heightfield), so it has no mass to simulate.
+    #[error("shape {0} has no volume, so it has no mass; give explicit mass properties")]
+    ZeroVolume(String),
     /// An index into a mesh's node arrays was out of range.
     #[error("{what} index {index} is out of range for {len} nodes")]
     IndexOutOfRange {

@@ -51,6 +51,7 @@ pub mod error;
 pub mod integrator;
 pub mod particles;
 pub mod quarantine;
+pub mod rigid;
 pub mod scenes;
 pub mod schedule;
 pub mod springs;
@@ -68,6 +69,12 @@ pub use particles::{
     VelocityField, VelocityFieldPlugin,
 };
 pub use quarantine::{BodyQuarantined, QuarantineReason, Quarantined};
+pub use rigid::{
+    AngularDamping, AngularMomentum, AngularVelocity, CenterOfMass, ExternalForceAtPoint,
+    ExternalImpulseAtPoint, ExternalTorque, Inertia, KinematicTarget, MassProperties,
+    OrientationUpdate, Renormalization, RigidBody, RigidBodyBundle, RigidBodyPlugin, Rotation,
+    SkipRenormalization, Torque,
+};
 pub use schedule::{
     ForceSchedule, ForceSystems, PhysicsSchedule, PhysicsSystems, StepSystems, SubstepSchedule,
 };
@@ -119,7 +126,7 @@ impl Plugin for PhysicsCorePlugin {
     }
 }
 
-/// Every effect: core, gravity, damping, velocity fields and springs.
+/// Every effect: core, gravity, damping, velocity fields, springs and rigid bodies.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct PhysicsPlugins;
 
@@ -129,7 +136,8 @@ impl Plugin for PhysicsPlugins {
             .add_physics(GravityPlugin)
             .add_physics(DampingPlugin)
             .add_physics(VelocityFieldPlugin)
-            .add_physics(SpringPlugin);
+            .add_physics(SpringPlugin)
+            .add_physics(RigidBodyPlugin);
     }
 }
 

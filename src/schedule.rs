@@ -103,6 +103,16 @@ pub enum ForceSystems {
     User,
 }
 
+/// The two stages inside [`StepSystems::IntegrateVelocities`]: impulses first (they change
+/// v and L), then the integrators.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum IntegrationSystems {
+    /// One-shot impulses.
+    Impulses,
+    /// The velocity phase of each integrator, linear and angular.
+    Integrate,
+}
+
 /// Timing probes between the step sets; probe k runs just before `StepSystems::ORDER[k]`.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub(crate) struct ProbeSystems(pub u8);
@@ -155,6 +165,12 @@ pub(crate) fn init_schedules(world: &mut World) {
             ProbeSystems(8),
         )
             .chain(),
+    );
+
+    substep.configure_sets(
+        (IntegrationSystems::Impulses, IntegrationSystems::Integrate)
+            .chain()
+            .in_set(StepSystems::IntegrateVelocities),
     );
 
     let mut forces = new_schedule(ForceSchedule, false);

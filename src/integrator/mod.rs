@@ -31,8 +31,10 @@
 //! t = 0.3 s for a 1 s period).
 
 mod plugin;
+mod stages;
 
-pub use plugin::{ConstraintsActive, IntegratorPlugin, Rk4Scratch};
+pub use plugin::{ConstraintsActive, IntegratorPlugin};
+pub use stages::{AngularRk4, Rk4Scratch};
 
 use bevy_ecs::prelude::*;
 use glam::Vec3A;

@@ -9,7 +9,10 @@ use crate::particles::{
     Position,
 };
 use crate::quarantine::{QuarantineReason, Quarantined};
-use crate::schedule::{ForceSchedule, StepSystems, add_force_systems, add_systems};
+use crate::rigid::{
+    AngularMomentum, CenterOfMass, ExternalImpulseAtPoint, Inertia, Rotation, world_point,
+};
+use crate::schedule::{IntegrationSystems, StepSystems, add_force_systems, add_systems};
 use crate::time::SubstepTime;
 use crate::{Plugin, SubstepSchedule};
 
@@ -40,15 +43,16 @@ impl Plugin for IntegratorPlugin {
             world,
             SubstepSchedule,
             (
-                (
-                    apply_impulses.run_if(any_with_component::<ExternalImpulse>),
-                    integrate_velocities,
-                )
-                    .chain()
-                    .in_set(StepSystems::IntegrateVelocities),
+                apply_impulses
+                    .run_if(
+                        any_with_component::<ExternalImpulse>
+                            .or_else(any_with_component::<ExternalImpulseAtPoint>),
+                    )
+                    .in_set(IntegrationSystems::Impulses),
+                integrate_velocities.in_set(IntegrationSystems::Integrate),
                 integrate_positions.in_set(StepSystems::IntegratePositions),
-                complete_stages
-                    .run_if(needs_stages)
+                super::stages::complete_stages
+                    .run_if(super::stages::needs_stages)
                     .in_set(StepSystems::CompleteStages),
             ),
         );
@@ -92,11 +96,30 @@ pub(crate) fn clear_forces(
     }
 }
 
-/// Δv = J / m, then J ← 0 without marking it changed (so the next step sees no new impulse).
+/// Δv = J / m (and ΔL = r × J at a point), then J ← 0 without marking it changed, so the next
+/// step sees no new impulse.
+#[allow(clippy::type_complexity)] // two queries of plain component tuples
 pub(crate) fn apply_impulses(
     mut bodies: Query<
         (&mut LinearVelocity, &mut ExternalImpulse, &Mass),
         (Changed<ExternalImpulse>, Live),
+    >,
+    mut at_points: Query<
+        (
+            &mut LinearVelocity,
+            &mut AngularMomentum,
+            &mut ExternalImpulseAtPoint,
+            &Mass,
+            &Inertia,
+            &Position,
+            &Rotation,
+            Option<&CenterOfMass>,
+        ),
+        (
+            Changed<ExternalImpulseAtPoint>,
+            Without<ExternalImpulse>,
+            Live,
+        ),
     >,
 ) {
     for (mut v, mut j, m) in &mut bodies {
@@ -104,6 +127,22 @@ pub(crate) fn apply_impulses(
             v.0 += Vec3A::from(j.0) * m.inverse();
             j.bypass_change_detection().0 = Vec3::ZERO;
         }
+    }
+    for (mut v, mut l, mut j, m, inertia, x, q, com) in &mut at_points {
+        if j.impulse == Vec3::ZERO {
+            continue;
+        }
+        let p = if j.local {
+            world_point(x.0, q.0, com.map_or(Vec3::ZERO, |c| c.0), j.point)
+        } else {
+            j.point.into()
+        };
+        let impulse = Vec3A::from(j.impulse);
+        v.0 += impulse * m.inverse();
+        if !inertia.is_infinite() {
+            l.0 += (p - x.0).cross(impulse);
+        }
+        j.bypass_change_detection().impulse = Vec3::ZERO;
     }
 }
 
@@ -283,191 +322,5 @@ fn integrate_positions(
         if probe != Vec3A::ZERO {
             quarantine_non_finite(&mut commands, e);
         }
-    }
-}
-
-fn needs_stages(global: Res<Integrator>, overrides: Query<&IntegratorOverride>) -> bool {
-    global.is_multistage() || overrides.iter().any(|o| o.0.is_multistage())
-}
-
-/// RK4 bookkeeping for one particle: the start state and the weighted derivative sums.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Rk4Scratch {
-    x0: Vec3A,
-    v0: Vec3A,
-    sum_x: Vec3A,
-    sum_v: Vec3A,
-}
-
-impl Rk4Scratch {
-    const WEIGHT: [f32; 4] = [1.0, 2.0, 2.0, 1.0];
-    const OFFSET: [f32; 3] = [0.5, 0.5, 1.0];
-
-    /// Starts a step from (x₀, v₀).
-    #[must_use]
-    #[inline]
-    pub fn begin(x0: Vec3A, v0: Vec3A) -> Self {
-        Self {
-            x0,
-            v0,
-            ..Default::default()
-        }
-    }
-
-    /// Records stage `k`'s derivative (ẋ, v̇) = (`v`, `a`), both taken at stage `k`'s state,
-    /// and returns the state of stage k + 1, or the end-of-step state after stage 3.
-    #[must_use]
-    #[inline]
-    pub fn stage(&mut self, k: usize, v: Vec3A, a: Vec3A, h: f32) -> (Vec3A, Vec3A) {
-        let w = Self::WEIGHT[k & 3];
-        self.sum_x += w * v;
-        self.sum_v += w * a;
-        if k < 3 {
-            let c = Self::OFFSET[k] * h;
-            (self.x0 + c * v, self.v0 + c * a)
-        } else {
-            let s = h / 6.0;
-            (self.x0 + s * self.sum_x, self.v0 + s * self.sum_v)
-        }
-    }
-}
-
-/// Reused allocations of [`complete_stages`].
-#[derive(Default)]
-struct StageScratch {
-    bodies: Vec<(Entity, Rk4Scratch)>,
-    verlet: Vec<Entity>,
-    meshes: Vec<(Entity, Integrator, Vec<Rk4Scratch>)>,
-}
-
-type StageBody<'a> = (
-    Entity,
-    &'a mut Position,
-    &'a mut LinearVelocity,
-    &'a Force,
-    &'a Mass,
-    Option<&'a IntegratorOverride>,
-);
-
-/// Verlet's second kick and RK4's stages 2–4. Each extra force evaluation re-runs
-/// [`ForceSchedule`]: the same systems as the substep's force sets.
-fn complete_stages(
-    world: &mut World,
-    bodies: &mut QueryState<StageBody, Live>,
-    meshes: &mut QueryState<(Entity, &mut Nodes, Option<&IntegratorOverride>), Live>,
-    mut scratch: Local<StageScratch>,
-) {
-    let global = *world.resource::<Integrator>();
-    let h = world.resource::<SubstepTime>().h;
-    let StageScratch {
-        bodies: rk4,
-        verlet,
-        meshes: mesh_stages,
-    } = &mut *scratch;
-    rk4.clear();
-    verlet.clear();
-    mesh_stages.clear();
-
-    // Stage 1: RK4 bodies still sit at (x₀, v₀) with forces f(x₀, v₀).
-    for (e, mut x, mut v, f, m, o) in bodies.iter_mut(world) {
-        match o.map_or(global, |o| o.0) {
-            Integrator::Rk4 => {
-                let mut s = Rk4Scratch::begin(x.0, v.0);
-                let (xs, vs) = s.stage(0, v.0, f.0 * m.inverse(), h);
-                (x.0, v.0) = (xs, vs);
-                rk4.push((e, s));
-            }
-            Integrator::VelocityVerlet => verlet.push(e),
-            _ => {}
-        }
-    }
-    for (e, mut nodes, o) in meshes.iter_mut(world) {
-        let method = o.map_or(global, |o| o.0);
-        if !method.is_multistage() {
-            continue;
-        }
-        let mut stages = Vec::new();
-        if method == Integrator::Rk4 {
-            let n = nodes.bypass_change_detection();
-            stages.reserve(n.x.len());
-            for i in 0..n.x.len() {
-                let mut s = Rk4Scratch::begin(n.x[i], n.v[i]);
-                (n.x[i], n.v[i]) = s.stage(0, n.v[i], n.f[i] * n.inv_mass[i], h);
-                stages.push(s);
-            }
-        }
-        mesh_stages.push((e, method, stages));
-    }
-    if rk4.is_empty() && verlet.is_empty() && mesh_stages.is_empty() {
-        return;
-    }
-
-    let _ = world.try_run_schedule(ForceSchedule);
-
-    // Verlet: v ← v½ + ½h a(x₁, v½).
-    for &e in verlet.iter() {
-        if let Ok((_, _, mut v, f, m, _)) = bodies.get_mut(world, e) {
-            v.0 = kick(v.0, f.0 * m.inverse(), 0.5 * h);
-        }
-    }
-    for (e, method, _) in mesh_stages.iter() {
-        if *method == Integrator::VelocityVerlet
-            && let Ok((_, mut nodes, _)) = meshes.get_mut(world, *e)
-        {
-            let n = nodes.bypass_change_detection();
-            for i in 0..n.v.len() {
-                n.v[i] = kick(n.v[i], n.f[i] * n.inv_mass[i], 0.5 * h);
-            }
-        }
-    }
-
-    let any_rk4 = !rk4.is_empty() || mesh_stages.iter().any(|m| m.1 == Integrator::Rk4);
-    if !any_rk4 {
-        return;
-    }
-    for k in 1..4 {
-        for (e, s) in rk4.iter_mut() {
-            if let Ok((_, mut x, mut v, f, m, _)) = bodies.get_mut(world, *e) {
-                let (xs, vs) = s.stage(k, v.0, f.0 * m.inverse(), h);
-                (x.0, v.0) = (xs, vs);
-            }
-        }
-        for (e, method, stages) in mesh_stages.iter_mut() {
-            if *method != Integrator::Rk4 {
-                continue;
-            }
-            if let Ok((_, mut nodes, _)) = meshes.get_mut(world, *e) {
-                let n = nodes.bypass_change_detection();
-                for (i, s) in stages.iter_mut().enumerate() {
-                    (n.x[i], n.v[i]) = s.stage(k, n.v[i], n.f[i] * n.inv_mass[i], h);
-                }
-            }
-        }
-        if k < 3 {
-            let _ = world.try_run_schedule(ForceSchedule);
-        }
-    }
-
-    // RK4 bodies skipped the position phase, so check them here.
-    let mut bad = Vec::new();
-    for (e, _) in rk4.iter() {
-        if let Ok((_, x, v, ..)) = bodies.get(world, *e)
-            && !(x.0.is_finite() && v.0.is_finite())
-        {
-            bad.push(*e);
-        }
-    }
-    for (e, method, _) in mesh_stages.iter() {
-        if *method == Integrator::Rk4
-            && let Ok((_, nodes, _)) = meshes.get(world, *e)
-            && !nodes.is_finite()
-        {
-            bad.push(*e);
-        }
-    }
-    for e in bad {
-        world.entity_mut(e).insert(Quarantined {
-            reason: QuarantineReason::NonFiniteState,
-        });
     }
 }

@@ -18,6 +18,10 @@
 //! allows r = 0. When the endpoints coincide the direction is undefined and the force is
 //! zero (for r = 0 that is also the limit). The potential energy is ½ k (l − r)².
 //!
+//! **Anchors.** [`Spring::with_anchors`] attaches the ends at body-frame points. The force
+//! acts along the line between the world anchors p = x + R (a − c), using the anchor velocity
+//! v + ω × r for damping, and a rigid endpoint also feels the torque r × f.
+//!
 //! Two representations share [`spring_force`]:
 //! - [`Spring`], one entity per spring between two body entities: flexible, for ropes,
 //!   hair and gameplay tethers.
@@ -30,13 +34,14 @@ mod plugin;
 
 pub use builders::{Chain, ChainBuilder, ClothBuilder};
 pub use plugin::SpringPlugin;
+pub(crate) use plugin::{Endpoint, anchor_state};
 
 use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
 use bevy_ecs::world::DeferredWorld;
-use glam::Vec3A;
+use glam::{Vec3, Vec3A};
 
-use crate::error::{Error, Result, non_negative, positive};
+use crate::error::{Error, Result, finite_vec, non_negative, positive};
 use crate::particles::{Nodes, Position};
 use crate::quarantine::{QuarantineReason, Quarantined};
 
@@ -86,6 +91,8 @@ pub struct Spring {
     rest_length: f32,
     stiffness: f32,
     damping: f32,
+    anchor_a: Vec3,
+    anchor_b: Vec3,
 }
 
 impl Spring {
@@ -117,7 +124,27 @@ impl Spring {
             rest_length: non_negative("rest length", r)?,
             stiffness: non_negative("spring stiffness", k)?,
             damping: non_negative("spring damping", c)?,
+            anchor_a: Vec3::ZERO,
+            anchor_b: Vec3::ZERO,
         })
+    }
+
+    /// Attaches the ends at points of the bodies (m, each body's shape frame; for a particle,
+    /// an offset from its position). On a rigid body an anchor away from the centre of mass
+    /// makes the spring exert a torque r × f.
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`].
+    pub fn with_anchors(mut self, anchor_a: Vec3, anchor_b: Vec3) -> Result<Self> {
+        self.anchor_a = finite_vec("spring anchor", anchor_a)?;
+        self.anchor_b = finite_vec("spring anchor", anchor_b)?;
+        Ok(self)
+    }
+
+    /// Anchors (body frame) of the two ends.
+    #[must_use]
+    pub fn anchors(&self) -> (Vec3, Vec3) {
+        (self.anchor_a, self.anchor_b)
     }
 
     /// Spawns this spring after checking that both endpoints are bodies.

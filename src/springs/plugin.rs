@@ -3,8 +3,11 @@
 use bevy_ecs::prelude::*;
 
 use super::{Spring, SpringNetwork, spring_force};
+use glam::Vec3A;
+
 use crate::particles::{Force, LinearVelocity, Nodes, Position};
 use crate::quarantine::{QuarantineReason, Quarantined};
+use crate::rigid::{AngularVelocity, CenterOfMass, Rotation, Torque};
 use crate::schedule::{
     ForceSystems, PhysicsSchedule, PhysicsSystems, add_force_systems, add_systems,
 };
@@ -37,33 +40,58 @@ impl Plugin for SpringPlugin {
     }
 }
 
+/// The spring's view of one endpoint: the world anchor, its velocity and the lever arm.
+pub(crate) type Endpoint<'a> = (
+    &'a Position,
+    &'a LinearVelocity,
+    Option<&'a Rotation>,
+    Option<&'a AngularVelocity>,
+    Option<&'a CenterOfMass>,
+);
+
+/// World anchor p, its velocity v + ω × r and the lever arm r = p − x.
+#[inline]
+pub(crate) fn anchor_state(e: Endpoint, anchor: glam::Vec3) -> (Vec3A, Vec3A, Vec3A) {
+    let (x, v, q, w, com) = e;
+    let r = match (q, anchor == glam::Vec3::ZERO && com.is_none()) {
+        (_, true) => Vec3A::ZERO,
+        (Some(q), _) => q.0 * Vec3A::from(anchor - com.map_or(glam::Vec3::ZERO, |c| c.0)),
+        (None, _) => Vec3A::from(anchor),
+    };
+    let vel = match w {
+        Some(w) if r != Vec3A::ZERO => v.0 + w.0.cross(r),
+        _ => v.0,
+    };
+    (x.0 + r, vel, r)
+}
+
 fn apply_spring_forces(
     springs: Query<&Spring, Live>,
-    states: Query<(&Position, &LinearVelocity), Live>,
-    mut forces: Query<&mut Force, Live>,
+    states: Query<Endpoint, Live>,
+    mut forces: Query<(&mut Force, Option<&mut Torque>), Live>,
 ) {
     for s in &springs {
         // A quarantined or missing endpoint drops out of the query, so NaN can't cross.
-        let (Ok((xa, va)), Ok((xb, vb))) = (states.get(s.a), states.get(s.b)) else {
+        let (Ok(ea), Ok(eb)) = (states.get(s.a), states.get(s.b)) else {
             continue;
         };
-        let f = spring_force(
-            xa.0,
-            xb.0,
-            va.0,
-            vb.0,
-            s.rest_length,
-            s.stiffness,
-            s.damping,
-        );
+        let (pa, va, ra) = anchor_state(ea, s.anchor_a);
+        let (pb, vb, rb) = anchor_state(eb, s.anchor_b);
+        let f = spring_force(pa, pb, va, vb, s.rest_length, s.stiffness, s.damping);
         if !f.is_finite() {
             continue;
         }
-        if let Ok(mut fa) = forces.get_mut(s.a) {
+        if let Ok((mut fa, ta)) = forces.get_mut(s.a) {
             fa.bypass_change_detection().0 += f;
+            if let Some(mut t) = ta {
+                t.bypass_change_detection().0 += ra.cross(f);
+            }
         }
-        if let Ok(mut fb) = forces.get_mut(s.b) {
+        if let Ok((mut fb, tb)) = forces.get_mut(s.b) {
             fb.bypass_change_detection().0 -= f;
+            if let Some(mut t) = tb {
+                t.bypass_change_detection().0 -= rb.cross(f);
+            }
         }
     }
 }

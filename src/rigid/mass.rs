@@ -1,0 +1,217 @@
+//! Mass properties from parry shapes, and the rigid-body bundle.
+//!
+//! For a shape of density ρ (kg/m³), parry integrates m = ρ V, the centre of mass c and the
+//! inertia tensor about c; compound shapes combine their parts with the parallel-axis
+//! theorem, I = I_c + m (|d|² E − d dᵀ) ([`parallel_axis`]). hooke validates the result: a
+//! shape with no volume (a flat hull, an open mesh, a heightfield) has no mass and is an
+//! error rather than a body that divides by zero.
+
+use bevy_ecs::prelude::*;
+use glam::{Mat3, Quat, Vec3};
+use parry3d::shape::Shape;
+
+use super::{AngularVelocity, CenterOfMass, Inertia, RigidBody, Rotation, check_density};
+use crate::error::{Error, Result, finite_vec};
+use crate::particles::{LinearVelocity, Mass, Position};
+
+/// The inertia tensor about a point displaced by `d` (m) from the centre of mass:
+/// I = I_c + m (|d|² E − d dᵀ).
+#[must_use]
+pub fn parallel_axis(i_com: Mat3, mass: f32, d: Vec3) -> Mat3 {
+    let outer = Mat3::from_cols(d * d.x, d * d.y, d * d.z);
+    i_com + mass * (Mat3::from_diagonal(Vec3::splat(d.length_squared())) - outer)
+}
+
+/// Mass m (kg), centre of mass c (m, shape frame) and inertia about c.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MassProperties {
+    /// m (kg).
+    pub mass: f32,
+    /// c (m), in the shape's frame.
+    pub center_of_mass: Vec3,
+    /// Inertia about c, in the shape's frame.
+    pub inertia: Inertia,
+}
+
+impl MassProperties {
+    /// Explicit mass properties (for an override, or a body without a shape).
+    ///
+    /// # Errors
+    /// [`Error::InvalidMass`] or [`Error::NonFinite`].
+    pub fn new(mass: f32, center_of_mass: Vec3, inertia: Inertia) -> Result<Self> {
+        Mass::new(mass)?;
+        Ok(Self {
+            mass,
+            center_of_mass: finite_vec("center of mass", center_of_mass)?,
+            inertia,
+        })
+    }
+
+    /// From a full inertia tensor about the centre of mass (diagonalised for you).
+    ///
+    /// # Errors
+    /// [`Error::InvalidMass`], [`Error::NonFinite`], or [`Error::NotPositive`] when the
+    /// tensor is not positive definite.
+    pub fn from_tensor(mass: f32, center_of_mass: Vec3, tensor: Mat3) -> Result<Self> {
+        if !tensor.is_finite() {
+            return Err(Error::NonFinite {
+                what: "inertia tensor",
+                value: format!("{tensor}"),
+            });
+        }
+        let sym = 0.5 * (tensor + tensor.transpose());
+        let p = parry3d::mass_properties::MassProperties::with_inertia_matrix(
+            center_of_mass,
+            mass,
+            sym,
+        );
+        // parry clamps negative eigenvalues to zero; read them back to reject them.
+        let principal = p.principal_inertia();
+        let inertia = Inertia::new(principal, p.principal_inertia_local_frame)?;
+        Self::new(mass, center_of_mass, inertia)
+    }
+
+    /// Integrates a parry shape at `density` (kg/m³).
+    ///
+    /// # Errors
+    /// [`Error::NotPositive`] for a non-positive density; [`Error::ZeroVolume`] for a shape
+    /// with no volume; [`Error::NotPositive`] for a degenerate (not positive-definite)
+    /// inertia.
+    pub fn from_shape(shape: &dyn Shape, density: f32) -> Result<Self> {
+        let density = check_density(density)?;
+        let p = shape.mass_properties(density);
+        let mass = p.mass();
+        if !(mass.is_finite() && mass > 0.0) || p.inv_mass == 0.0 {
+            return Err(Error::ZeroVolume(format!("{:?}", shape.shape_type())));
+        }
+        let inertia = Inertia::new(p.principal_inertia(), p.principal_inertia_local_frame)?;
+        Self::new(mass, p.local_com, inertia)
+    }
+
+    /// The same body with its mass scaled to `mass` (inertia scales with it).
+    ///
+    /// # Errors
+    /// [`Error::InvalidMass`].
+    pub fn with_mass(self, mass: f32) -> Result<Self> {
+        Mass::new(mass)?;
+        let s = mass / self.mass;
+        let inertia = Inertia::new(self.inertia.principal() * s, self.inertia.frame())?;
+        Ok(Self {
+            mass,
+            inertia,
+            ..self
+        })
+    }
+}
+
+/// Everything a dynamic or kinematic rigid body needs. Static bodies need only
+/// `(RigidBody::Static, Position, Rotation)`; see [`RigidBodyBundle::fixed`].
+#[derive(Bundle, Debug, Clone, Copy)]
+pub struct RigidBodyBundle {
+    /// Dynamic or kinematic.
+    pub kind: RigidBody,
+    /// Centre of mass in the world (m).
+    pub position: Position,
+    /// Orientation.
+    pub rotation: Rotation,
+    /// v (m/s).
+    pub velocity: LinearVelocity,
+    /// ω (rad/s); sets L = I ω at the first step.
+    pub angular_velocity: AngularVelocity,
+    /// m.
+    pub mass: Mass,
+    /// I₀.
+    pub inertia: Inertia,
+    /// c in the shape frame.
+    pub center_of_mass: CenterOfMass,
+}
+
+impl RigidBodyBundle {
+    /// A dynamic body with the given mass properties, at rest at the origin.
+    ///
+    /// # Errors
+    /// [`Error::InvalidMass`] (only for values built by hand).
+    pub fn dynamic(props: MassProperties) -> Result<Self> {
+        Ok(Self {
+            kind: RigidBody::Dynamic,
+            position: Position::default(),
+            rotation: Rotation::default(),
+            velocity: LinearVelocity::default(),
+            angular_velocity: AngularVelocity::default(),
+            mass: Mass::new(props.mass)?,
+            inertia: props.inertia,
+            center_of_mass: CenterOfMass(props.center_of_mass),
+        })
+    }
+
+    /// A dynamic body from a parry shape and a density (kg/m³).
+    ///
+    /// # Errors
+    /// As [`MassProperties::from_shape`].
+    pub fn from_shape(shape: &dyn Shape, density: f32) -> Result<Self> {
+        Self::dynamic(MassProperties::from_shape(shape, density)?)
+    }
+
+    /// A kinematic body: infinite mass and inertia, moved by the velocities you set.
+    #[must_use]
+    pub fn kinematic() -> Self {
+        Self {
+            kind: RigidBody::Kinematic,
+            position: Position::default(),
+            rotation: Rotation::default(),
+            velocity: LinearVelocity::default(),
+            angular_velocity: AngularVelocity::default(),
+            mass: Mass::PINNED,
+            inertia: Inertia::INFINITE,
+            center_of_mass: CenterOfMass::default(),
+        }
+    }
+
+    /// A static body's components: it never moves and no system visits it.
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`].
+    pub fn fixed(position: Vec3, rotation: Quat) -> Result<(RigidBody, Position, Rotation)> {
+        Ok((
+            RigidBody::Static,
+            Position::try_new(position)?,
+            Rotation::try_new(rotation)?,
+        ))
+    }
+
+    /// Puts the centre of mass at `x` (m).
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`].
+    pub fn at(mut self, x: Vec3) -> Result<Self> {
+        self.position = Position::try_new(x)?;
+        Ok(self)
+    }
+
+    /// Sets the orientation (normalised).
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`] for a non-finite or zero quaternion.
+    pub fn with_rotation(mut self, q: Quat) -> Result<Self> {
+        self.rotation = Rotation::try_new(q)?;
+        Ok(self)
+    }
+
+    /// Sets the velocity of the centre of mass (m/s).
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`].
+    pub fn with_velocity(mut self, v: Vec3) -> Result<Self> {
+        self.velocity = LinearVelocity::try_new(v)?;
+        Ok(self)
+    }
+
+    /// Sets the angular velocity (rad/s, world frame).
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`].
+    pub fn with_angular_velocity(mut self, omega: Vec3) -> Result<Self> {
+        self.angular_velocity = AngularVelocity::from(finite_vec("angular velocity", omega)?);
+        Ok(self)
+    }
+}

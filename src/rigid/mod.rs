@@ -1,0 +1,432 @@
+//! Rigid bodies: the lecture's state (x, R, P, L).
+//!
+//! A rigid body is a particle ([`crate::Position`] = centre of mass x, [`crate::LinearVelocity`]
+//! v = P/M, [`crate::Mass`], [`crate::Force`]) plus an orientation and angular momentum:
+//!
+//! ```text
+//! dx/dt = v          dP/dt = f
+//! dq/dt = ½ ω ⊗ q    dL/dt = τ
+//! I = R I₀ Rᵀ,       ω = I⁻¹ L
+//! ```
+//!
+//! - [`Rotation`] q is a unit quaternion (body → world).
+//! - [`AngularMomentum`] L (kg·m²/s, world frame) is the state that is integrated.
+//! - [`AngularVelocity`] ω (rad/s, world frame) is derived from L after every substep. Writing
+//!   it from game code sets L = I ω at the next step (so "spin at 5 rad/s" just works).
+//!   Writing [`AngularMomentum`] instead sets ω = I⁻¹ L. hooke itself updates both without
+//!   change ticks, so `Changed<AngularVelocity>` means "a user wrote it".
+//! - [`Inertia`] holds I₀ by its principal moments and principal frame, and their inverse.
+//! - [`Torque`] τ (N·m) accumulates like [`crate::Force`]: cleared to [`ExternalTorque`], then
+//!   springs at anchors and [`ExternalForceAtPoint`]s add r × f.
+//! - [`CenterOfMass`] is the centre of mass in the shape's frame: the body's frame origin is
+//!   x − R c.
+//!
+//! **Orientation update.** With ω fixed over a step, the first-order update
+//! q ← q + ½ h ω ⊗ q grows |q| by √(1 + (|ω|h/2)²) per step; the exponential map
+//! q ← exp(½ h ω) ⊗ q is exact for constant ω and keeps |q| = 1 up to rounding. The
+//! exponential map is the default ([`OrientationUpdate`]); RK4 integrates q as a 4-vector
+//! with the first-order derivative at each stage, as the lecture writes it. The
+//! [`StepSystems::Renormalize`](crate::StepSystems::Renormalize) set renormalises q every
+//! substep unless [`Renormalization`] is off (to show its effect) or a body has
+//! [`SkipRenormalization`].
+//!
+//! **Kinds.** [`RigidBody::Dynamic`] bodies respond to forces. [`RigidBody::Kinematic`] bodies
+//! have infinite mass and inertia and move with the velocities you set, or toward a
+//! [`KinematicTarget`]. [`RigidBody::Static`] bodies have no mass components at all, so no
+//! physics system ever visits them.
+
+mod mass;
+mod plugin;
+
+pub use mass::{MassProperties, RigidBodyBundle, parallel_axis};
+pub use plugin::RigidBodyPlugin;
+
+use bevy_ecs::prelude::*;
+use glam::{Quat, Vec3, Vec3A};
+
+use crate::error::{Error, Result, finite, finite_vec, non_negative};
+use crate::particles::Position;
+use crate::quarantine::{Validate, validate_on_insert};
+
+/// How a rigid body moves. Spawn bodies with [`RigidBodyBundle`].
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[require(Position, Rotation)]
+pub enum RigidBody {
+    /// Moved by forces and torques.
+    #[default]
+    Dynamic,
+    /// Moved by the velocities (or [`KinematicTarget`]) you give it; pushes, never pushed.
+    Kinematic,
+    /// Never moves.
+    Static,
+}
+
+/// Orientation q, a unit quaternion from body to world frame.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = validate_on_insert::<Self>)]
+pub struct Rotation(pub Quat);
+
+impl Default for Rotation {
+    fn default() -> Self {
+        Self(Quat::IDENTITY)
+    }
+}
+
+impl Validate for Rotation {
+    fn validate(&self) -> Result<()> {
+        let q = self.0;
+        if !q.is_finite() || q.length_squared() < 1e-12 {
+            return Err(Error::NonFinite {
+                what: "rotation (finite and non-zero)",
+                value: format!("{q}"),
+            });
+        }
+        Ok(())
+    }
+}
+
+impl Rotation {
+    /// A validated rotation, normalised.
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`] for a non-finite or zero quaternion.
+    pub fn try_new(q: Quat) -> Result<Self> {
+        Rotation(q).validate()?;
+        Ok(Self(q.normalize()))
+    }
+}
+
+macro_rules! angular_vec {
+    ($(#[$doc:meta])* $name:ident, $what:literal) => {
+        $(#[$doc])*
+        #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+        #[component(on_insert = validate_on_insert::<Self>)]
+        pub struct $name(pub Vec3A);
+
+        impl Validate for $name {
+            fn validate(&self) -> Result<()> {
+                finite_vec($what, self.0.into()).map(|_| ())
+            }
+        }
+
+        impl From<Vec3> for $name {
+            fn from(v: Vec3) -> Self {
+                Self(v.into())
+            }
+        }
+
+        impl $name {
+            /// The value as a plain `Vec3`.
+            #[must_use]
+            pub fn get(&self) -> Vec3 {
+                self.0.into()
+            }
+        }
+    };
+}
+
+angular_vec!(
+    /// ω (rad/s, world frame), derived from L every substep; writing it sets L = I ω.
+    AngularVelocity,
+    "angular velocity"
+);
+angular_vec!(
+    /// L (kg·m²/s, world frame): the integrated rotational state.
+    AngularMomentum,
+    "angular momentum"
+);
+angular_vec!(
+    /// A torque (N·m, world frame) added after every clear, until changed or removed.
+    ExternalTorque,
+    "external torque"
+);
+
+/// The torque accumulator τ (N·m, world frame), like [`crate::Force`].
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+pub struct Torque(pub Vec3A);
+
+/// Centre of mass in the body's shape frame (m). The frame origin in the world is x − R c.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+pub struct CenterOfMass(pub Vec3);
+
+/// The body-frame inertia tensor I₀ = F diag(p) Fᵀ, stored by its principal moments p
+/// (kg·m²) and principal frame F, with the inverse moments. Infinite moments (inverse 0)
+/// make a body that torques cannot turn.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[require(AngularMomentum, AngularVelocity, Torque, Rotation)]
+pub struct Inertia {
+    principal: Vec3A,
+    inverse: Vec3A,
+    frame: Quat,
+}
+
+impl Inertia {
+    /// Infinite inertia: torque never changes the spin (kinematic bodies).
+    pub const INFINITE: Inertia = Inertia {
+        principal: Vec3A::INFINITY,
+        inverse: Vec3A::ZERO,
+        frame: Quat::IDENTITY,
+    };
+
+    /// Principal moments `principal` (kg·m²) about the axes of `frame` (body frame).
+    ///
+    /// # Errors
+    /// [`Error::NotPositive`] unless every moment is positive and finite (the tensor must be
+    /// positive definite), [`Error::NonFinite`] for a bad frame.
+    pub fn new(principal: Vec3, frame: Quat) -> Result<Self> {
+        for p in principal.to_array() {
+            if !(p.is_finite() && p > 0.0 && (1.0 / p).is_finite()) {
+                return Err(Error::NotPositive {
+                    what: "principal moment of inertia",
+                    value: p,
+                });
+            }
+        }
+        let frame = Rotation::try_new(frame)?.0;
+        Ok(Self {
+            principal: principal.into(),
+            inverse: principal.recip().into(),
+            frame,
+        })
+    }
+
+    /// Inertia of a diagonal tensor diag(ixx, iyy, izz) in the body frame.
+    ///
+    /// # Errors
+    /// As [`Inertia::new`].
+    pub fn diagonal(ixx: f32, iyy: f32, izz: f32) -> Result<Self> {
+        Self::new(Vec3::new(ixx, iyy, izz), Quat::IDENTITY)
+    }
+
+    /// Principal moments (kg·m²).
+    #[must_use]
+    pub fn principal(&self) -> Vec3 {
+        self.principal.into()
+    }
+
+    /// Principal frame in the body frame.
+    #[must_use]
+    pub fn frame(&self) -> Quat {
+        self.frame
+    }
+
+    /// The body-frame tensor I₀ as a matrix.
+    #[must_use]
+    pub fn tensor(&self) -> glam::Mat3 {
+        let f = glam::Mat3::from_quat(self.frame);
+        f * glam::Mat3::from_diagonal(self.principal.into()) * f.transpose()
+    }
+
+    /// True for infinite inertia (a body torques cannot turn).
+    #[must_use]
+    pub fn is_infinite(&self) -> bool {
+        self.inverse == Vec3A::ZERO
+    }
+
+    /// ω = I⁻¹ L with I = R I₀ Rᵀ, for orientation `q`.
+    #[must_use]
+    #[inline]
+    pub fn angular_velocity(&self, q: Quat, l: Vec3A) -> Vec3A {
+        let qf = q * self.frame;
+        qf * (self.inverse * (qf.inverse() * l))
+    }
+
+    /// L = I ω with I = R I₀ Rᵀ, for orientation `q` (zero for infinite inertia, which keeps
+    /// no momentum of its own).
+    #[must_use]
+    #[inline]
+    pub fn angular_momentum(&self, q: Quat, omega: Vec3A) -> Vec3A {
+        if self.is_infinite() {
+            return Vec3A::ZERO;
+        }
+        let qf = q * self.frame;
+        qf * (self.principal * (qf.inverse() * omega))
+    }
+}
+
+/// How [`Rotation`] advances from ω over a step.
+#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum OrientationUpdate {
+    /// q ← exp(½ h ω) ⊗ q: exact for constant ω, keeps |q| = 1. The default.
+    #[default]
+    ExpMap,
+    /// q ← q + ½ h ω ⊗ q: the lecture's first-order step; |q| grows by √(1 + (|ω|h/2)²).
+    FirstOrder,
+}
+
+/// Whether the renormalise set restores |q| = 1 every substep (default: on).
+#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Renormalization(pub bool);
+
+impl Default for Renormalization {
+    fn default() -> Self {
+        Self(true)
+    }
+}
+
+/// Opts one body out of renormalisation (to show the drift it prevents).
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SkipRenormalization;
+
+/// A force applied at a point, every step until changed or removed: adds f to the force
+/// and (p − x) × f to the torque.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = validate_on_insert::<Self>)]
+pub struct ExternalForceAtPoint {
+    /// Force (N, world frame).
+    pub force: Vec3,
+    /// Point of application (m): in the body's shape frame if `local`, else in the world.
+    pub point: Vec3,
+    /// Whether `point` is in the body frame (it then moves with the body).
+    pub local: bool,
+}
+
+impl Validate for ExternalForceAtPoint {
+    fn validate(&self) -> Result<()> {
+        finite_vec("force", self.force)?;
+        finite_vec("point of application", self.point).map(|_| ())
+    }
+}
+
+/// A one-shot impulse J (N·s, world frame) at a point: Δv = J/m, ΔL = (p − x) × J at the
+/// next substep, then the impulse is reset to zero (like [`crate::ExternalImpulse`]).
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = validate_on_insert::<Self>)]
+pub struct ExternalImpulseAtPoint {
+    /// Impulse (N·s, world frame).
+    pub impulse: Vec3,
+    /// Point (m): body frame if `local`, else world.
+    pub point: Vec3,
+    /// Whether `point` is in the body frame.
+    pub local: bool,
+}
+
+impl Validate for ExternalImpulseAtPoint {
+    fn validate(&self) -> Result<()> {
+        finite_vec("impulse", self.impulse)?;
+        finite_vec("point of application", self.point).map(|_| ())
+    }
+}
+
+/// Angular drag coefficient c (1/s): τ = −c L, so spin decays like e^(−c t).
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[component(on_insert = validate_on_insert::<Self>)]
+pub struct AngularDamping(pub f32);
+
+impl Validate for AngularDamping {
+    fn validate(&self) -> Result<()> {
+        non_negative("angular damping", self.0).map(|_| ())
+    }
+}
+
+/// A pose a kinematic body should reach by the end of each step: hooke sets its velocities
+/// to (target − x)/dt and the rotation difference over dt.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = validate_on_insert::<Self>)]
+pub struct KinematicTarget {
+    /// Target centre-of-mass position (m).
+    pub position: Vec3,
+    /// Target orientation.
+    pub rotation: Quat,
+}
+
+impl Validate for KinematicTarget {
+    fn validate(&self) -> Result<()> {
+        finite_vec("target position", self.position)?;
+        Rotation(self.rotation).validate()
+    }
+}
+
+/// The world point of `local` (m, body shape frame) for a body at `x` with orientation `q`
+/// and centre of mass `com` (body frame): x + R (local − com).
+#[must_use]
+#[inline]
+pub fn world_point(x: Vec3A, q: Quat, com: Vec3, local: Vec3) -> Vec3A {
+    x + q * Vec3A::from(local - com)
+}
+
+/// dq/dt = ½ ω ⊗ q (as a 4-vector).
+#[must_use]
+#[inline]
+pub fn quat_derivative(q: Quat, omega: Vec3A) -> Quat {
+    Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0) * q * 0.5
+}
+
+/// One orientation step with ω held constant over `h`.
+#[must_use]
+#[inline]
+pub fn integrate_rotation(q: Quat, omega: Vec3A, h: f32, update: OrientationUpdate) -> Quat {
+    match update {
+        OrientationUpdate::ExpMap => Quat::from_scaled_axis((omega * h).into()) * q,
+        OrientationUpdate::FirstOrder => q + quat_derivative(q, omega) * h,
+    }
+}
+
+/// Kinetic energy of rotation ½ ω·L (J).
+#[must_use]
+#[inline]
+pub fn rotational_energy(omega: Vec3A, l: Vec3A) -> f32 {
+    0.5 * omega.dot(l)
+}
+
+/// ω for integration: derived from L, except for infinite inertia (kinematic bodies), whose
+/// ω is whatever the user set.
+#[inline]
+pub(crate) fn omega_of(inertia: &Inertia, q: Quat, l: Vec3A, stored: Vec3A) -> Vec3A {
+    if inertia.is_infinite() {
+        stored
+    } else {
+        inertia.angular_velocity(q, l)
+    }
+}
+
+pub(crate) fn check_density(density: f32) -> Result<f32> {
+    finite("density", density)?;
+    if density <= 0.0 {
+        return Err(Error::NotPositive {
+            what: "density",
+            value: density,
+        });
+    }
+    Ok(density)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn omega_and_momentum_are_inverse_for_any_orientation() {
+        let inertia = Inertia::new(Vec3::new(1.0, 2.0, 3.0), Quat::from_rotation_y(0.3)).unwrap();
+        let q = Quat::from_euler(glam::EulerRot::XYZ, 0.4, -1.1, 2.0);
+        let omega = Vec3A::new(0.3, -2.0, 1.5);
+        let l = inertia.angular_momentum(q, omega);
+        assert!((inertia.angular_velocity(q, l) - omega).length() < 1e-5);
+        // Against the matrix form I = R I₀ Rᵀ.
+        let r = glam::Mat3::from_quat(q);
+        let i_world = r * inertia.tensor() * r.transpose();
+        assert!((Vec3A::from(i_world * Vec3::from(omega)) - l).length() < 1e-4);
+    }
+
+    #[test]
+    fn first_order_update_grows_the_norm_by_the_closed_form() {
+        let omega = Vec3A::new(0.0, 50.0, 0.0);
+        let h = 1.0 / 60.0;
+        let q = integrate_rotation(Quat::IDENTITY, omega, h, OrientationUpdate::FirstOrder);
+        let expected = (1.0 + (50.0 * h / 2.0f32).powi(2)).sqrt();
+        assert!((q.length() - expected).abs() < 1e-6);
+        let q = integrate_rotation(Quat::IDENTITY, omega, h, OrientationUpdate::ExpMap);
+        assert!((q.length() - 1.0).abs() < 1e-6);
+        assert!((q.to_scaled_axis() - Vec3::new(0.0, 50.0 * h, 0.0)).length() < 1e-5);
+    }
+
+    #[test]
+    fn bad_inertia_is_rejected() {
+        assert!(Inertia::diagonal(1.0, 0.0, 1.0).is_err());
+        assert!(Inertia::diagonal(1.0, -1.0, 1.0).is_err());
+        assert!(Inertia::diagonal(f32::NAN, 1.0, 1.0).is_err());
+        assert!(Inertia::new(Vec3::ONE, Quat::from_xyzw(0.0, 0.0, 0.0, 0.0)).is_err());
+        assert!(Rotation::try_new(Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0)).is_err());
+        assert!(check_density(0.0).is_err() && check_density(-2.0).is_err());
+    }
+}

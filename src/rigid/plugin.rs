@@ -1,0 +1,273 @@
+//! Rigid-body systems: the angular half of each integrator, torques, renormalisation.
+
+use bevy_ecs::prelude::*;
+use glam::Vec3A;
+
+use super::{
+    AngularDamping, AngularMomentum, AngularVelocity, CenterOfMass, ExternalForceAtPoint,
+    ExternalTorque, Inertia, KinematicTarget, OrientationUpdate, Renormalization, Rotation,
+    SkipRenormalization, Torque, integrate_rotation, omega_of, world_point,
+};
+use crate::Plugin;
+use crate::integrator::{Integrator, IntegratorOverride};
+use crate::particles::{Force, LinearVelocity, Position};
+use crate::quarantine::{QuarantineReason, Quarantined};
+use crate::schedule::{
+    ForceSystems, IntegrationSystems, PhysicsSchedule, PhysicsSystems, StepSystems,
+    SubstepSchedule, add_force_systems, add_systems,
+};
+use crate::time::{PhysicsTime, SubstepTime};
+
+type Live = Without<Quarantined>;
+
+/// Rotation, angular momentum, torque and renormalisation for bodies with [`Inertia`]. Every
+/// system runs only while such a body exists (or, for the optional inputs, while one has
+/// them).
+#[derive(Debug, Default, Clone, Copy)]
+pub struct RigidBodyPlugin;
+
+impl Plugin for RigidBodyPlugin {
+    fn build(&self, world: &mut World) {
+        world.init_resource::<OrientationUpdate>();
+        world.init_resource::<Renormalization>();
+        add_systems(
+            world,
+            PhysicsSchedule,
+            (
+                drive_kinematic_targets.run_if(any_with_component::<KinematicTarget>),
+                sync_angular_inputs.run_if(any_with_component::<Inertia>),
+            )
+                .chain()
+                .in_set(PhysicsSystems::Prepare),
+        );
+        add_force_systems(world, || {
+            (
+                clear_torques
+                    .run_if(any_with_component::<Inertia>)
+                    .in_set(StepSystems::ClearForces),
+                apply_angular_damping
+                    .run_if(any_with_component::<AngularDamping>)
+                    .in_set(ForceSystems::Damping),
+                apply_forces_at_points
+                    .run_if(any_with_component::<ExternalForceAtPoint>)
+                    .in_set(StepSystems::AccumulateTorque),
+            )
+        });
+        add_systems(
+            world,
+            SubstepSchedule,
+            (
+                integrate_angular_momenta
+                    .run_if(any_with_component::<Inertia>)
+                    .in_set(IntegrationSystems::Integrate),
+                integrate_orientations
+                    .run_if(any_with_component::<Inertia>)
+                    .in_set(StepSystems::IntegratePositions),
+                (renormalize_rotations, update_angular_velocities)
+                    .chain()
+                    .run_if(any_with_component::<Inertia>)
+                    .in_set(StepSystems::Renormalize),
+            ),
+        );
+    }
+}
+
+/// Makes user writes consistent: a written ω sets L = I ω, a written L sets ω = I⁻¹ L. At
+/// spawn both count as written; a non-zero ω wins.
+fn sync_angular_inputs(
+    mut bodies: Query<
+        (
+            &Rotation,
+            &Inertia,
+            &mut AngularVelocity,
+            &mut AngularMomentum,
+        ),
+        Or<(Changed<AngularVelocity>, Changed<AngularMomentum>)>,
+    >,
+) {
+    for (q, inertia, mut w, mut l) in &mut bodies {
+        let (w_changed, l_changed) = (w.is_changed(), l.is_changed());
+        if w_changed && (!l_changed || w.0 != Vec3A::ZERO) {
+            l.bypass_change_detection().0 = inertia.angular_momentum(q.0, w.0);
+        } else if l_changed && !inertia.is_infinite() {
+            w.bypass_change_detection().0 = inertia.angular_velocity(q.0, l.0);
+        }
+    }
+}
+
+/// v = (target − x)/dt and ω = log(q_target q⁻¹)/dt, so the pose is reached at the step's end.
+fn drive_kinematic_targets(
+    time: Res<PhysicsTime>,
+    mut bodies: Query<
+        (
+            &Position,
+            &Rotation,
+            &KinematicTarget,
+            &mut LinearVelocity,
+            &mut AngularVelocity,
+        ),
+        Live,
+    >,
+) {
+    let dt = time.dt();
+    for (x, q, target, mut v, mut w) in &mut bodies {
+        v.0 = (Vec3A::from(target.position) - x.0) / dt;
+        let mut dq = target.rotation.normalize() * q.0.inverse();
+        if dq.w < 0.0 {
+            dq = -dq;
+        }
+        w.0 = Vec3A::from(dq.to_scaled_axis()) / dt;
+    }
+}
+
+/// τ ← external torque, or zero.
+fn clear_torques(
+    mut plain: Query<&mut Torque, (Without<ExternalTorque>, Live)>,
+    mut external: Query<(&mut Torque, &ExternalTorque), Live>,
+) {
+    plain
+        .iter_mut()
+        .for_each(|mut t| t.bypass_change_detection().0 = Vec3A::ZERO);
+    external
+        .iter_mut()
+        .for_each(|(mut t, e)| t.bypass_change_detection().0 = e.0);
+}
+
+/// τ −= c L.
+fn apply_angular_damping(
+    mut bodies: Query<(&mut Torque, &AngularMomentum, &AngularDamping), Live>,
+) {
+    for (mut t, l, c) in &mut bodies {
+        t.bypass_change_detection().0 -= c.0 * l.0;
+    }
+}
+
+/// f += F, τ += (p − x) × F.
+fn apply_forces_at_points(
+    mut bodies: Query<
+        (
+            &Position,
+            &Rotation,
+            Option<&CenterOfMass>,
+            &ExternalForceAtPoint,
+            &mut Force,
+            &mut Torque,
+        ),
+        Live,
+    >,
+) {
+    for (x, q, com, ext, mut f, mut t) in &mut bodies {
+        let p = if ext.local {
+            world_point(x.0, q.0, com.map_or(glam::Vec3::ZERO, |c| c.0), ext.point)
+        } else {
+            ext.point.into()
+        };
+        let force = Vec3A::from(ext.force);
+        f.bypass_change_detection().0 += force;
+        t.bypass_change_detection().0 += (p - x.0).cross(force);
+    }
+}
+
+type AngularState<'a> = (
+    &'a mut Rotation,
+    &'a mut AngularMomentum,
+    &'a AngularVelocity,
+    &'a Torque,
+    &'a Inertia,
+    Option<&'a IntegratorOverride>,
+);
+
+/// The angular half of the velocity phase: L advances from τ (explicit Euler also turns q
+/// with the start-of-step ω here).
+fn integrate_angular_momenta(
+    global: Res<Integrator>,
+    update: Res<OrientationUpdate>,
+    time: Res<SubstepTime>,
+    mut bodies: Query<AngularState, Live>,
+) {
+    let h = time.h;
+    for (mut q, mut l, w, t, inertia, o) in &mut bodies {
+        let method = o.map_or(*global, |o| o.0);
+        let kick = |l: Vec3A, scale: f32| {
+            if inertia.is_infinite() {
+                l
+            } else {
+                l + (scale * h) * t.0
+            }
+        };
+        match method {
+            Integrator::ExplicitEuler => {
+                let omega = omega_of(inertia, q.0, l.0, w.0);
+                q.0 = integrate_rotation(q.0, omega, h, *update);
+                l.bypass_change_detection().0 = kick(l.0, 1.0);
+            }
+            Integrator::SymplecticEuler => l.bypass_change_detection().0 = kick(l.0, 1.0),
+            Integrator::VelocityVerlet => l.bypass_change_detection().0 = kick(l.0, 0.5),
+            Integrator::Rk4 => {}
+        }
+    }
+}
+
+/// The angular half of the position phase: q advances with ω = I(q)⁻¹ L of the new L.
+fn integrate_orientations(
+    mut commands: Commands,
+    global: Res<Integrator>,
+    update: Res<OrientationUpdate>,
+    time: Res<SubstepTime>,
+    mut bodies: Query<
+        (
+            Entity,
+            &mut Rotation,
+            &AngularMomentum,
+            &AngularVelocity,
+            &Inertia,
+            Option<&IntegratorOverride>,
+        ),
+        Live,
+    >,
+) {
+    let h = time.h;
+    for (e, mut q, l, w, inertia, o) in &mut bodies {
+        let method = o.map_or(*global, |o| o.0);
+        if matches!(
+            method,
+            Integrator::SymplecticEuler | Integrator::VelocityVerlet
+        ) {
+            let omega = omega_of(inertia, q.0, l.0, w.0);
+            q.0 = integrate_rotation(q.0, omega, h, *update);
+        }
+        if !(q.0.is_finite() && l.0.is_finite()) {
+            commands.entity(e).insert(Quarantined {
+                reason: QuarantineReason::NonFiniteState,
+            });
+        }
+    }
+}
+
+/// q ← q / |q|, without a change tick: the orientation system already marked it.
+fn renormalize_rotations(
+    on: Res<Renormalization>,
+    mut bodies: Query<&mut Rotation, (With<Inertia>, Without<SkipRenormalization>, Live)>,
+) {
+    if !on.0 {
+        return;
+    }
+    for mut q in &mut bodies {
+        let n = q.0.normalize();
+        if n.is_finite() {
+            q.bypass_change_detection().0 = n;
+        }
+    }
+}
+
+/// ω = I(q)⁻¹ L after the substep, for everything that reads ω (springs at anchors,
+/// diagnostics, game code).
+fn update_angular_velocities(
+    mut bodies: Query<(&Rotation, &AngularMomentum, &Inertia, &mut AngularVelocity), Live>,
+) {
+    for (q, l, inertia, mut w) in &mut bodies {
+        if !inertia.is_infinite() {
+            w.bypass_change_detection().0 = inertia.angular_velocity(q.0, l.0);
+        }
+    }
+}
