@@ -97,7 +97,7 @@ impl AngularRk4 {
     pub fn stage(&mut self, k: usize, q: Quat, omega: Vec3A, tau: Vec3A, h: f32) -> (Quat, Vec3A) {
         let dq = quat_derivative(q, omega);
         let w = WEIGHT[k & 3];
-        self.sum_q = self.sum_q + dq * w;
+        self.sum_q += dq * w;
         self.sum_l += w * tau;
         if k < 3 {
             let c = OFFSET[k] * h;

@@ -21,11 +21,13 @@
 //! - [`CenterOfMass`] is the centre of mass in the shape's frame: the body's frame origin is
 //!   x − R c.
 //!
-//! **Orientation update.** With ω fixed over a step, the first-order update
-//! q ← q + ½ h ω ⊗ q grows |q| by √(1 + (|ω|h/2)²) per step; the exponential map
-//! q ← exp(½ h ω) ⊗ q is exact for constant ω and keeps |q| = 1 up to rounding. The
-//! exponential map is the default ([`OrientationUpdate`]); RK4 integrates q as a 4-vector
-//! with the first-order derivative at each stage, as the lecture writes it. The
+//! **Orientation update** ([`OrientationUpdate`]). With ω fixed over a step, the
+//! first-order update q ← q + ½ h ω ⊗ q grows |q| by √(1 + (|ω|h/2)²) per step; the
+//! exponential map q ← exp(½ h ω) ⊗ q is exact for constant ω and keeps |q| = 1. Both hold
+//! ω = I(q)⁻¹L at the start orientation, and on an asymmetric body that pumps energy in: a
+//! spin about the major axis creeps towards the minor axis. The default is therefore a
+//! free-rotation splitting ([`free_rotation_split`]): symplectic, |L| exact, energy error
+//! bounded. RK4 integrates q as a 4-vector with the derivative ½ ω ⊗ q at each stage. The
 //! [`StepSystems::Renormalize`](crate::StepSystems::Renormalize) set renormalises q every
 //! substep unless [`Renormalization`] is off (to show its effect) or a body has
 //! [`SkipRenormalization`].
@@ -227,7 +229,9 @@ impl Inertia {
     #[must_use]
     #[inline]
     pub fn angular_velocity(&self, q: Quat, l: Vec3A) -> Vec3A {
-        let qf = q * self.frame;
+        // Normalised first: rotating by a non-unit quaternion scales by |q|², and q is not
+        // unit between a first-order update and the renormalise set (or when it is off).
+        let qf = q.normalize() * self.frame;
         qf * (self.inverse * (qf.inverse() * l))
     }
 
@@ -239,18 +243,28 @@ impl Inertia {
         if self.is_infinite() {
             return Vec3A::ZERO;
         }
-        let qf = q * self.frame;
+        let qf = q.normalize() * self.frame;
         qf * (self.principal * (qf.inverse() * omega))
     }
 }
 
-/// How [`Rotation`] advances from ω over a step.
+/// How [`Rotation`] advances over a step (for the Euler and Verlet integrators; RK4 always
+/// integrates q̇ = ½ ω ⊗ q at its stages).
 #[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum OrientationUpdate {
-    /// q ← exp(½ h ω) ⊗ q: exact for constant ω, keeps |q| = 1. The default.
+    /// Free-rotation splitting (the default): the kinetic energy Σ Lᵢ²/2Iᵢ is split into
+    /// three spins about the principal axes, each solved exactly (L fixed in the world, the
+    /// body turning about axis i at Lᵢ/Iᵢ). Lie–Trotter order for the Euler integrators,
+    /// Strang order for Verlet. It is symplectic: |L| is exact and the energy error stays
+    /// bounded, with no drift. Costs three (five for Verlet) axis rotations.
     #[default]
+    Splitting,
+    /// q ← exp(½ h ω) ⊗ q with ω = I(q)⁻¹L held over the step: exact for constant ω and keeps
+    /// |q| = 1, but on an asymmetric body the energy drifts steadily up, towards a spin about
+    /// the minor axis (measured: +194 % over 10⁴ steps at 60 Hz for I = diag(1, 2, 3)).
     ExpMap,
-    /// q ← q + ½ h ω ⊗ q: the lecture's first-order step; |q| grows by √(1 + (|ω|h/2)²).
+    /// q ← q + ½ h ω ⊗ q: the lecture's first-order step; |q| grows by √(1 + (|ω|h/2)²)
+    /// per step until renormalised, and the energy drifts as with [`OrientationUpdate::ExpMap`].
     FirstOrder,
 }
 
@@ -352,14 +366,51 @@ pub fn quat_derivative(q: Quat, omega: Vec3A) -> Quat {
     Quat::from_xyzw(omega.x, omega.y, omega.z, 0.0) * q * 0.5
 }
 
-/// One orientation step with ω held constant over `h`.
+/// One orientation step with ω held constant over `h` (the splitting update needs L and
+/// the inertia: see [`free_rotation_split`]; here it falls back to the exponential map).
 #[must_use]
 #[inline]
 pub fn integrate_rotation(q: Quat, omega: Vec3A, h: f32, update: OrientationUpdate) -> Quat {
     match update {
-        OrientationUpdate::ExpMap => Quat::from_scaled_axis((omega * h).into()) * q,
+        OrientationUpdate::ExpMap | OrientationUpdate::Splitting => {
+            Quat::from_scaled_axis((omega * h).into()) * q
+        }
         OrientationUpdate::FirstOrder => q + quat_derivative(q, omega) * h,
     }
+}
+
+/// The free-rotation splitting step for a body with world angular momentum `l` held over
+/// `h`: exact spins about the principal axes in the order 1, 2, 3 (`strang == false`, first
+/// order) or ½1, ½2, 3, ½2, ½1 (`strang == true`, second order).
+#[must_use]
+#[inline]
+pub fn free_rotation_split(q: Quat, inertia: &Inertia, l: Vec3A, h: f32, strang: bool) -> Quat {
+    // p maps the principal frame to the world; each sub-flow turns it about one of its own
+    // axes (right multiplication) at the rate L_body,i / I_i, which leaves world L fixed.
+    let mut p = q.normalize() * inertia.frame;
+    let mut spin = |axis: usize, dt: f32| {
+        let lb = p.inverse() * l;
+        let angle = dt * lb[axis] * inertia.inverse[axis];
+        let r = match axis {
+            0 => Quat::from_rotation_x(angle),
+            1 => Quat::from_rotation_y(angle),
+            _ => Quat::from_rotation_z(angle),
+        };
+        p *= r;
+    };
+    if strang {
+        let half = 0.5 * h;
+        spin(0, half);
+        spin(1, half);
+        spin(2, h);
+        spin(1, half);
+        spin(0, half);
+    } else {
+        spin(0, h);
+        spin(1, h);
+        spin(2, h);
+    }
+    p * inertia.frame.inverse()
 }
 
 /// Kinetic energy of rotation ½ ω·L (J).

@@ -1,12 +1,12 @@
 //! Rigid-body systems: the angular half of each integrator, torques, renormalisation.
 
 use bevy_ecs::prelude::*;
-use glam::Vec3A;
+use glam::{Quat, Vec3A};
 
 use super::{
     AngularDamping, AngularMomentum, AngularVelocity, CenterOfMass, ExternalForceAtPoint,
     ExternalTorque, Inertia, KinematicTarget, OrientationUpdate, Renormalization, Rotation,
-    SkipRenormalization, Torque, integrate_rotation, omega_of, world_point,
+    SkipRenormalization, Torque, free_rotation_split, integrate_rotation, omega_of, world_point,
 };
 use crate::Plugin;
 use crate::integrator::{Integrator, IntegratorOverride};
@@ -72,19 +72,17 @@ impl Plugin for RigidBodyPlugin {
     }
 }
 
+type AngularInputs<'a> = (
+    &'a Rotation,
+    &'a Inertia,
+    &'a mut AngularVelocity,
+    &'a mut AngularMomentum,
+);
+type WrittenByUser = Or<(Changed<AngularVelocity>, Changed<AngularMomentum>)>;
+
 /// Makes user writes consistent: a written ω sets L = I ω, a written L sets ω = I⁻¹ L. At
 /// spawn both count as written; a non-zero ω wins.
-fn sync_angular_inputs(
-    mut bodies: Query<
-        (
-            &Rotation,
-            &Inertia,
-            &mut AngularVelocity,
-            &mut AngularMomentum,
-        ),
-        Or<(Changed<AngularVelocity>, Changed<AngularMomentum>)>,
-    >,
-) {
+fn sync_angular_inputs(mut bodies: Query<AngularInputs, WrittenByUser>) {
     for (q, inertia, mut w, mut l) in &mut bodies {
         let (w_changed, l_changed) = (w.is_changed(), l.is_changed());
         if w_changed && (!l_changed || w.0 != Vec3A::ZERO) {
@@ -95,20 +93,16 @@ fn sync_angular_inputs(
     }
 }
 
+type KinematicDrive<'a> = (
+    &'a Position,
+    &'a Rotation,
+    &'a KinematicTarget,
+    &'a mut LinearVelocity,
+    &'a mut AngularVelocity,
+);
+
 /// v = (target − x)/dt and ω = log(q_target q⁻¹)/dt, so the pose is reached at the step's end.
-fn drive_kinematic_targets(
-    time: Res<PhysicsTime>,
-    mut bodies: Query<
-        (
-            &Position,
-            &Rotation,
-            &KinematicTarget,
-            &mut LinearVelocity,
-            &mut AngularVelocity,
-        ),
-        Live,
-    >,
-) {
+fn drive_kinematic_targets(time: Res<PhysicsTime>, mut bodies: Query<KinematicDrive, Live>) {
     let dt = time.dt();
     for (x, q, target, mut v, mut w) in &mut bodies {
         v.0 = (Vec3A::from(target.position) - x.0) / dt;
@@ -142,20 +136,17 @@ fn apply_angular_damping(
     }
 }
 
+type PointForce<'a> = (
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    &'a ExternalForceAtPoint,
+    &'a mut Force,
+    &'a mut Torque,
+);
+
 /// f += F, τ += (p − x) × F.
-fn apply_forces_at_points(
-    mut bodies: Query<
-        (
-            &Position,
-            &Rotation,
-            Option<&CenterOfMass>,
-            &ExternalForceAtPoint,
-            &mut Force,
-            &mut Torque,
-        ),
-        Live,
-    >,
-) {
+fn apply_forces_at_points(mut bodies: Query<PointForce, Live>) {
     for (x, q, com, ext, mut f, mut t) in &mut bodies {
         let p = if ext.local {
             world_point(x.0, q.0, com.map_or(glam::Vec3::ZERO, |c| c.0), ext.point)
@@ -177,6 +168,25 @@ type AngularState<'a> = (
     Option<&'a IntegratorOverride>,
 );
 
+/// One orientation step with L held: splitting for bodies with finite inertia, otherwise
+/// the chosen ω-held update (kinematic bodies turn at their set ω).
+#[inline]
+fn turn(
+    q: Quat,
+    l: Vec3A,
+    stored: Vec3A,
+    inertia: &Inertia,
+    h: f32,
+    update: OrientationUpdate,
+    strang: bool,
+) -> Quat {
+    if update == OrientationUpdate::Splitting && !inertia.is_infinite() {
+        free_rotation_split(q, inertia, l, h, strang)
+    } else {
+        integrate_rotation(q, omega_of(inertia, q, l, stored), h, update)
+    }
+}
+
 /// The angular half of the velocity phase: L advances from τ (explicit Euler also turns q
 /// with the start-of-step ω here).
 fn integrate_angular_momenta(
@@ -197,8 +207,7 @@ fn integrate_angular_momenta(
         };
         match method {
             Integrator::ExplicitEuler => {
-                let omega = omega_of(inertia, q.0, l.0, w.0);
-                q.0 = integrate_rotation(q.0, omega, h, *update);
+                q.0 = turn(q.0, l.0, w.0, inertia, h, *update, false);
                 l.bypass_change_detection().0 = kick(l.0, 1.0);
             }
             Integrator::SymplecticEuler => l.bypass_change_detection().0 = kick(l.0, 1.0),
@@ -208,23 +217,22 @@ fn integrate_angular_momenta(
     }
 }
 
+type OrientationState<'a> = (
+    Entity,
+    &'a mut Rotation,
+    &'a AngularMomentum,
+    &'a AngularVelocity,
+    &'a Inertia,
+    Option<&'a IntegratorOverride>,
+);
+
 /// The angular half of the position phase: q advances with ω = I(q)⁻¹ L of the new L.
 fn integrate_orientations(
     mut commands: Commands,
     global: Res<Integrator>,
     update: Res<OrientationUpdate>,
     time: Res<SubstepTime>,
-    mut bodies: Query<
-        (
-            Entity,
-            &mut Rotation,
-            &AngularMomentum,
-            &AngularVelocity,
-            &Inertia,
-            Option<&IntegratorOverride>,
-        ),
-        Live,
-    >,
+    mut bodies: Query<OrientationState, Live>,
 ) {
     let h = time.h;
     for (e, mut q, l, w, inertia, o) in &mut bodies {
@@ -233,9 +241,10 @@ fn integrate_orientations(
             method,
             Integrator::SymplecticEuler | Integrator::VelocityVerlet
         ) {
-            let omega = omega_of(inertia, q.0, l.0, w.0);
-            q.0 = integrate_rotation(q.0, omega, h, *update);
+            let strang = method == Integrator::VelocityVerlet;
+            q.0 = turn(q.0, l.0, w.0, inertia, h, *update, strang);
         }
+
         if !(q.0.is_finite() && l.0.is_finite()) {
             commands.entity(e).insert(Quarantined {
                 reason: QuarantineReason::NonFiniteState,
