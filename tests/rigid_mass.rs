@@ -197,7 +197,7 @@ fn parallel_axis_off_diagonal_terms() {
 #[test]
 fn full_tensors_are_diagonalised_and_bad_ones_rejected() {
     // diag(1, 2, 3) turned by 30° about z.
-    let r = Mat3::from_quat(Quat::from_rotation_z(0.5236));
+    let r = Mat3::from_quat(Quat::from_rotation_z(std::f32::consts::FRAC_PI_6));
     let tensor = r * Mat3::from_diagonal(Vec3::new(1.0, 2.0, 3.0)) * r.transpose();
     let p = MassProperties::from_tensor(1.0, Vec3::ZERO, tensor).unwrap();
     assert_moments(&p, [1.0, 2.0, 3.0], "rotated tensor");
