@@ -148,4 +148,79 @@ fn main() {
         reference,
         "the price of 4 field evaluations",
     );
+    rotation_kernels(&cfg);
+}
+
+/// Rotation kernels, each against a trivial quaternion product over the same data.
+pub fn rotation_kernels(cfg: &Config) {
+    use glam::Quat;
+    use hooke::Inertia;
+    use hooke::rigid::{OrientationUpdate, free_rotation_split, integrate_rotation};
+    let n = 100_000;
+    let inertia = Inertia::diagonal(1.0, 2.0, 3.0).unwrap();
+    let l: Vec<Vec3A> = points(n, 4).iter().map(|p| *p * 3.0).collect();
+    let mut q = vec![Quat::IDENTITY; n];
+    let mut q_ref = vec![Quat::IDENTITY; n];
+    let h = 1.0 / 60.0;
+    let turn = Quat::from_rotation_y(0.01);
+    let mut reference = || {
+        for qi in q_ref.iter_mut() {
+            *qi = (*qi * turn).normalize();
+        }
+        black_box(&q_ref);
+    };
+    let (ours, r) = compare(
+        cfg,
+        || {
+            for i in 0..n {
+                q[i] = free_rotation_split(q[i], &inertia, l[i], h, false);
+            }
+            black_box(&q);
+        },
+        &mut reference,
+    );
+    line(
+        "kernel_rotation_split_100k_vs_quat_mul",
+        ours,
+        r,
+        &format!("{:.1} ns/body", ours / n as f64),
+    );
+    let (ours, r) = compare(
+        cfg,
+        || {
+            for i in 0..n {
+                q[i] = integrate_rotation(
+                    q[i],
+                    inertia.angular_velocity(q[i], l[i]),
+                    h,
+                    OrientationUpdate::ExpMap,
+                );
+            }
+            black_box(&q);
+        },
+        &mut reference,
+    );
+    line(
+        "kernel_rotation_expmap_100k_vs_quat_mul",
+        ours,
+        r,
+        &format!("{:.1} ns/body, with ω = I⁻¹L", ours / n as f64),
+    );
+    let mut w = vec![Vec3A::ZERO; n];
+    let (ours, r) = compare(
+        cfg,
+        || {
+            for i in 0..n {
+                w[i] = inertia.angular_velocity(q[i], l[i]);
+            }
+            black_box(&w);
+        },
+        &mut reference,
+    );
+    line(
+        "kernel_omega_from_l_100k_vs_quat_mul",
+        ours,
+        r,
+        &format!("{:.1} ns/body", ours / n as f64),
+    );
 }

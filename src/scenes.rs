@@ -131,3 +131,37 @@ pub fn showcase(world: &mut World) -> Result<Showcase> {
         particles,
     })
 }
+
+/// Half extents (m) and density (kg/m³) of the tumbling-box scene.
+pub const TUMBLING_BOX: (glam::Vec3, f32) = (glam::Vec3::new(0.3, 0.2, 0.1), 500.0);
+
+/// Start position and angular velocity of box `i` of the tumbling-box scene: a 2 m lattice
+/// (so no two boxes could touch) with spins up to 6 rad/s about every axis.
+#[must_use]
+pub fn tumbling_box_start(i: usize, n: usize) -> (Vec3, Vec3) {
+    let side = (n as f32).cbrt().ceil() as usize;
+    let (a, b, c) = (i % side, (i / side) % side, i / (side * side));
+    let x = Vec3::new(a as f32, b as f32 + 50.0, c as f32) * 2.0;
+    (x, jitter(i) * 6.0)
+}
+
+/// `n` free tumbling boxes ([`TUMBLING_BOX`]), falling under gravity with no contacts.
+///
+/// # Errors
+/// None in practice; constructor errors are forwarded.
+pub fn tumbling_boxes(world: &mut World, n: usize) -> Result<()> {
+    let (half, density) = TUMBLING_BOX;
+    let shape = parry3d::shape::Cuboid::new(half);
+    let props = crate::MassProperties::from_shape(&shape, density)?;
+    let mut batch = Vec::with_capacity(n);
+    for i in 0..n {
+        let (x, omega) = tumbling_box_start(i, n);
+        batch.push(
+            crate::RigidBodyBundle::dynamic(props)?
+                .at(x)?
+                .with_angular_velocity(omega)?,
+        );
+    }
+    world.spawn_batch(batch);
+    Ok(())
+}

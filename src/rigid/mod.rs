@@ -229,9 +229,9 @@ impl Inertia {
     #[must_use]
     #[inline]
     pub fn angular_velocity(&self, q: Quat, l: Vec3A) -> Vec3A {
-        // Normalised first: rotating by a non-unit quaternion scales by |q|², and q is not
-        // unit between a first-order update and the renormalise set (or when it is off).
-        let qf = q.normalize() * self.frame;
+        // Rotating by a non-unit quaternion scales by |q|², and q is not unit between a
+        // first-order update and the renormalise set (or when that is off).
+        let qf = unit(q) * self.frame;
         qf * (self.inverse * (qf.inverse() * l))
     }
 
@@ -243,8 +243,19 @@ impl Inertia {
         if self.is_infinite() {
             return Vec3A::ZERO;
         }
-        let qf = q.normalize() * self.frame;
+        let qf = unit(q) * self.frame;
         qf * (self.principal * (qf.inverse() * omega))
+    }
+}
+
+/// `q` normalised, skipping the square root when it already is (the common case: a
+/// predictable branch is cheaper than a sqrt and a division on the dependency chain).
+#[inline]
+fn unit(q: Quat) -> Quat {
+    if (q.length_squared() - 1.0).abs() < 1e-6 {
+        q
+    } else {
+        q.normalize()
     }
 }
 
@@ -387,17 +398,25 @@ pub fn integrate_rotation(q: Quat, omega: Vec3A, h: f32, update: OrientationUpda
 pub fn free_rotation_split(q: Quat, inertia: &Inertia, l: Vec3A, h: f32, strang: bool) -> Quat {
     // p maps the principal frame to the world; each sub-flow turns it about one of its own
     // axes (right multiplication) at the rate L_body,i / I_i, which leaves world L fixed.
-    let mut p = q.normalize() * inertia.frame;
+    let mut p = unit(q) * inertia.frame;
+
+    // L in the principal frame, carried along: turning the body by θ about axis i turns
+    // its body-frame L by −θ about the same axis, which only mixes the other two
+    // components. One full rotation instead of one per spin keeps the dependency chain short.
+    let mut lb = (p.inverse() * l).to_array();
+    let inv = inertia.inverse.to_array();
     let mut spin = |axis: usize, dt: f32| {
-        let lb = p.inverse() * l;
-        let angle = dt * lb[axis] * inertia.inverse[axis];
-        let r = match axis {
-            0 => Quat::from_rotation_x(angle),
-            1 => Quat::from_rotation_y(angle),
-            _ => Quat::from_rotation_z(angle),
-        };
-        p *= r;
+        let (s, c) = (0.5 * dt * lb[axis] * inv[axis]).sin_cos();
+        let (j, k) = ((axis + 1) % 3, (axis + 2) % 3);
+        let (sin, cos) = (2.0 * s * c, 1.0 - 2.0 * s * s);
+        let (a, b) = (lb[j], lb[k]);
+        lb[j] = cos * a + sin * b;
+        lb[k] = cos * b - sin * a;
+        let mut r = [0.0, 0.0, 0.0, c];
+        r[axis] = s;
+        p *= Quat::from_array(r);
     };
+
     if strang {
         let half = 0.5 * h;
         spin(0, half);

@@ -8,7 +8,8 @@
 //! cargo run --release --example perf_report -- --quick
 //! ```
 
-#[path = "common/timing.rs"]
+mod rigid;
+#[path = "../common/timing.rs"]
 mod timing;
 
 use std::hint::black_box;
@@ -376,6 +377,9 @@ fn main() {
     cloth_springs(&cfg, 316);
     empty_world(&cfg);
     all_plugins_vs_needed(&cfg, 100_000);
+    rigid::rigid_free(&cfg, 1_000);
+    rigid::rigid_free(&cfg, 100_000);
+
     accuracy_dial(&cfg);
     println!("\n# total {:.1} s", start.elapsed().as_secs_f64());
 }
