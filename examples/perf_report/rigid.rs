@@ -2,7 +2,6 @@
 
 use std::hint::black_box;
 
-use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3, Vec3A};
 use hooke::prelude::*;
 use hooke::rigid::free_rotation_split;
