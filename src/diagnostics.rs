@@ -23,7 +23,7 @@ use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, rotational_energy}
 use crate::schedule::{
     PhysicsSchedule, PhysicsSystems, ProbeSystems, StepSystems, SubstepSchedule, add_systems,
 };
-use crate::springs::{Endpoint, Spring, SpringNetwork, anchor_state, spring_energy};
+use crate::springs::{Endpoint, Spinning, Spring, SpringNetwork, anchor_state, spring_energy};
 
 /// How many things of each kind the world holds (quarantined ones counted apart).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -178,6 +178,7 @@ fn measure_energy(
     meshes: Query<(&Nodes, Option<&SpringNetwork>), Live>,
     springs: Query<&Spring, Live>,
     states: Query<Endpoint, Live>,
+    spinning: Query<Spinning, Live>,
     rotating: Query<(&AngularVelocity, &AngularMomentum, &Inertia), Live>,
     tracers: Query<(), (With<Tracer>, Live)>,
     quarantined: Query<(), With<Quarantined>>,
@@ -214,8 +215,8 @@ fn measure_energy(
         counts.springs += 1;
         if let (Ok(a), Ok(b)) = (states.get(s.a()), states.get(s.b())) {
             let (anchor_a, anchor_b) = s.anchors();
-            let (pa, _, _) = anchor_state(a, anchor_a);
-            let (pb, _, _) = anchor_state(b, anchor_b);
+            let (pa, _, _) = anchor_state(a, spinning.get(s.a()).ok(), anchor_a);
+            let (pb, _, _) = anchor_state(b, spinning.get(s.b()).ok(), anchor_b);
             us += f64::from(spring_energy(pa, pb, s.rest_length(), s.stiffness()));
         }
     }

@@ -10,7 +10,8 @@ use crate::particles::{
 };
 use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::rigid::{
-    AngularMomentum, CenterOfMass, ExternalImpulseAtPoint, Inertia, Rotation, world_point,
+    AngularMomentum, CenterOfMass, ExternalImpulseAtPoint, ExternalTorque, Inertia, Rotation,
+    Torque, world_point,
 };
 use crate::schedule::{IntegrationSystems, StepSystems, add_force_systems, add_systems};
 use crate::time::SubstepTime;
@@ -61,7 +62,9 @@ impl Plugin for IntegratorPlugin {
 
 type Live = Without<Quarantined>;
 
-/// Initialises every accumulator with the body's constant forces: f ← f_ext + m g s.
+/// Initialises every accumulator with the body's constant forces, f ← f_ext + m g s, and
+/// every torque accumulator with its constant torque, τ ← τ_ext.
+
 ///
 /// Gravity and external forces don't depend on the state, so they are written here in the one
 /// pass that has to touch every accumulator anyway; state-dependent forces are added in
@@ -74,6 +77,8 @@ pub(crate) fn clear_forces(
     mut scaled: Query<(&mut Force, &Mass, &GravityScale), (Without<ExternalForce>, Live)>,
     mut external: Query<(&mut Force, &Mass, &ExternalForce, Option<&GravityScale>), Live>,
     mut meshes: Query<&mut Nodes, Live>,
+    mut plain_torques: Query<&mut Torque, (Without<ExternalTorque>, Live)>,
+    mut external_torques: Query<(&mut Torque, &ExternalTorque), Live>,
 ) {
     let g = gravity.map_or(Vec3A::ZERO, |g| g.get().into());
     // Force is an accumulator nobody watches for changes; skipping the tick write keeps
@@ -94,6 +99,13 @@ pub(crate) fn clear_forces(
             *f = *m * g;
         }
     }
+    // Torques start at the external torque, likewise.
+    plain_torques
+        .iter_mut()
+        .for_each(|mut t| t.bypass_change_detection().0 = Vec3A::ZERO);
+    external_torques
+        .iter_mut()
+        .for_each(|(mut t, e)| t.bypass_change_detection().0 = e.0);
 }
 
 /// Δv = J / m (and ΔL = r × J at a point), then J ← 0 without marking it changed, so the next

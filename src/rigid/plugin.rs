@@ -4,9 +4,9 @@ use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3A};
 
 use super::{
-    AngularDamping, AngularMomentum, AngularVelocity, CenterOfMass, ExternalForceAtPoint,
-    ExternalTorque, Inertia, KinematicTarget, OrientationUpdate, Renormalization, Rotation,
-    SkipRenormalization, Torque, free_rotation_split, integrate_rotation, omega_of, world_point,
+    AngularDamping, AngularMomentum, AngularVelocity, CenterOfMass, ExternalForceAtPoint, Inertia,
+    KinematicTarget, OrientationUpdate, Renormalization, Rotation, SkipRenormalization, Torque,
+    free_rotation_split, integrate_rotation, omega_of, world_point,
 };
 use crate::Plugin;
 use crate::integrator::{Integrator, IntegratorOverride};
@@ -42,9 +42,6 @@ impl Plugin for RigidBodyPlugin {
         );
         add_force_systems(world, || {
             (
-                clear_torques
-                    .run_if(any_with_component::<Inertia>)
-                    .in_set(StepSystems::ClearForces),
                 apply_angular_damping
                     .run_if(any_with_component::<AngularDamping>)
                     .in_set(ForceSystems::Damping),
@@ -63,8 +60,7 @@ impl Plugin for RigidBodyPlugin {
                 integrate_orientations
                     .run_if(any_with_component::<Inertia>)
                     .in_set(StepSystems::IntegratePositions),
-                (renormalize_rotations, update_angular_velocities)
-                    .chain()
+                renormalize_rotations
                     .run_if(any_with_component::<Inertia>)
                     .in_set(StepSystems::Renormalize),
             ),
@@ -112,19 +108,6 @@ fn drive_kinematic_targets(time: Res<PhysicsTime>, mut bodies: Query<KinematicDr
         }
         w.0 = Vec3A::from(dq.to_scaled_axis()) / dt;
     }
-}
-
-/// τ ← external torque, or zero.
-fn clear_torques(
-    mut plain: Query<&mut Torque, (Without<ExternalTorque>, Live)>,
-    mut external: Query<(&mut Torque, &ExternalTorque), Live>,
-) {
-    plain
-        .iter_mut()
-        .for_each(|mut t| t.bypass_change_detection().0 = Vec3A::ZERO);
-    external
-        .iter_mut()
-        .for_each(|(mut t, e)| t.bypass_change_detection().0 = e.0);
 }
 
 /// τ −= c L.
@@ -253,28 +236,29 @@ fn integrate_orientations(
     }
 }
 
-/// q ← q / |q|, without a change tick: the orientation system already marked it.
+/// q ← q / |q| (unless renormalisation is off for the world or the body), then
+/// ω = I(q)⁻¹ L for everything that reads ω: springs at anchors, diagnostics, game code. One
+/// pass; neither write ticks change detection (the orientation system already marked q).
 fn renormalize_rotations(
     on: Res<Renormalization>,
-    mut bodies: Query<&mut Rotation, (With<Inertia>, Without<SkipRenormalization>, Live)>,
+    mut bodies: Query<
+        (
+            &mut Rotation,
+            &AngularMomentum,
+            &Inertia,
+            &mut AngularVelocity,
+            Has<SkipRenormalization>,
+        ),
+        Live,
+    >,
 ) {
-    if !on.0 {
-        return;
-    }
-    for mut q in &mut bodies {
-        let n = q.0.normalize();
-        if n.is_finite() {
-            q.bypass_change_detection().0 = n;
+    for (mut q, l, inertia, mut w, skip) in &mut bodies {
+        if on.0 && !skip {
+            let n = q.0.normalize();
+            if n.is_finite() {
+                q.bypass_change_detection().0 = n;
+            }
         }
-    }
-}
-
-/// ω = I(q)⁻¹ L after the substep, for everything that reads ω (springs at anchors,
-/// diagnostics, game code).
-fn update_angular_velocities(
-    mut bodies: Query<(&Rotation, &AngularMomentum, &Inertia, &mut AngularVelocity), Live>,
-) {
-    for (q, l, inertia, mut w) in &mut bodies {
         if !inertia.is_infinite() {
             w.bypass_change_detection().0 = inertia.angular_velocity(q.0, l.0);
         }

@@ -18,9 +18,10 @@
 //! allows r = 0. When the endpoints coincide the direction is undefined and the force is
 //! zero (for r = 0 that is also the limit). The potential energy is ½ k (l − r)².
 //!
-//! **Anchors.** [`Spring::with_anchors`] attaches the ends at body-frame points. The force
-//! acts along the line between the world anchors p = x + R (a − c), using the anchor velocity
-//! v + ω × r for damping, and a rigid endpoint also feels the torque r × f.
+//! **Anchors.** [`Spring::with_anchors`] attaches the ends at points a given relative to the
+//! centre of mass in body axes. The force acts along the line between the world anchors
+//! p = x + R a, using the anchor velocity v + ω × r (r = R a) for damping, and a rigid
+//! endpoint also feels the torque r × f.
 //!
 //! Two representations share [`spring_force`]:
 //! - [`Spring`], one entity per spring between two body entities: flexible, for ropes,
@@ -34,7 +35,7 @@ mod plugin;
 
 pub use builders::{Chain, ChainBuilder, ClothBuilder};
 pub use plugin::SpringPlugin;
-pub(crate) use plugin::{Endpoint, anchor_state};
+pub(crate) use plugin::{Endpoint, Spinning, anchor_state};
 
 use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
@@ -129,9 +130,10 @@ impl Spring {
         })
     }
 
-    /// Attaches the ends at points of the bodies (m, each body's shape frame; for a particle,
-    /// an offset from its position). On a rigid body an anchor away from the centre of mass
-    /// makes the spring exert a torque r × f.
+    /// Attaches the ends at points of the bodies (m, relative to each body's centre of mass
+    /// in its body axes; for a particle, a fixed world offset). On a rigid body an anchor away
+    /// from the centre of mass makes the spring exert a torque r × f. For a point given in
+    /// the shape's frame, subtract the [`crate::CenterOfMass`].
     ///
     /// # Errors
     /// [`Error::NonFinite`].

@@ -7,7 +7,9 @@ use glam::Vec3A;
 
 use crate::particles::{Force, LinearVelocity, Nodes, Position};
 use crate::quarantine::{QuarantineReason, Quarantined};
-use crate::rigid::{AngularVelocity, CenterOfMass, Rotation, Torque};
+use glam::Vec3;
+
+use crate::rigid::{AngularVelocity, Rotation, Torque};
 use crate::schedule::{
     ForceSystems, PhysicsSchedule, PhysicsSystems, add_force_systems, add_systems,
 };
@@ -40,58 +42,74 @@ impl Plugin for SpringPlugin {
     }
 }
 
-/// The spring's view of one endpoint: the world anchor, its velocity and the lever arm.
-pub(crate) type Endpoint<'a> = (
-    &'a Position,
-    &'a LinearVelocity,
-    Option<&'a Rotation>,
-    Option<&'a AngularVelocity>,
-    Option<&'a CenterOfMass>,
-);
+/// The spring's view of a body: position and velocity.
+pub(crate) type Endpoint<'a> = (&'a Position, &'a LinearVelocity);
 
-/// World anchor p, its velocity v + ω × r and the lever arm r = p − x.
+/// What an anchored end also needs: orientation and spin.
+pub(crate) type Spinning<'a> = (&'a Rotation, &'a AngularVelocity);
+
+/// World anchor p, its velocity v + ω × r and the lever arm r = R a (a relative to the centre
+/// of mass, body axes). A body without rotation uses a as a fixed world offset.
 #[inline]
-pub(crate) fn anchor_state(e: Endpoint, anchor: glam::Vec3) -> (Vec3A, Vec3A, Vec3A) {
-    let (x, v, q, w, com) = e;
-    let r = match (q, anchor == glam::Vec3::ZERO && com.is_none()) {
-        (_, true) => Vec3A::ZERO,
-        (Some(q), _) => q.0 * Vec3A::from(anchor - com.map_or(glam::Vec3::ZERO, |c| c.0)),
-        (None, _) => Vec3A::from(anchor),
-    };
-    let vel = match w {
-        Some(w) if r != Vec3A::ZERO => v.0 + w.0.cross(r),
-        _ => v.0,
-    };
-    (x.0 + r, vel, r)
+pub(crate) fn anchor_state(
+    e: Endpoint,
+    spin: Option<Spinning>,
+    anchor: Vec3,
+) -> (Vec3A, Vec3A, Vec3A) {
+    let (x, v) = e;
+    if anchor == Vec3::ZERO {
+        return (x.0, v.0, Vec3A::ZERO);
+    }
+    match spin {
+        Some((q, w)) => {
+            let r = q.0 * Vec3A::from(anchor);
+            (x.0 + r, v.0 + w.0.cross(r), r)
+        }
+        None => (x.0 + Vec3A::from(anchor), v.0, Vec3A::ZERO),
+    }
 }
 
 fn apply_spring_forces(
     springs: Query<&Spring, Live>,
     states: Query<Endpoint, Live>,
-    mut forces: Query<(&mut Force, Option<&mut Torque>), Live>,
+    spinning: Query<Spinning, Live>,
+    mut forces: Query<&mut Force, Live>,
+    mut torques: Query<&mut Torque, Live>,
 ) {
     for s in &springs {
         // A quarantined or missing endpoint drops out of the query, so NaN can't cross.
         let (Ok(ea), Ok(eb)) = (states.get(s.a), states.get(s.b)) else {
             continue;
         };
-        let (pa, va, ra) = anchor_state(ea, s.anchor_a);
-        let (pb, vb, rb) = anchor_state(eb, s.anchor_b);
+        // Rotation is looked up only for an anchored end: plain ropes pay for two lookups.
+        let spin = |e: Entity, anchor: Vec3| {
+            if anchor == Vec3::ZERO {
+                None
+            } else {
+                spinning.get(e).ok()
+            }
+        };
+        let (pa, va, ra) = anchor_state(ea, spin(s.a, s.anchor_a), s.anchor_a);
+        let (pb, vb, rb) = anchor_state(eb, spin(s.b, s.anchor_b), s.anchor_b);
         let f = spring_force(pa, pb, va, vb, s.rest_length, s.stiffness, s.damping);
         if !f.is_finite() {
             continue;
         }
-        if let Ok((mut fa, ta)) = forces.get_mut(s.a) {
+        if let Ok(mut fa) = forces.get_mut(s.a) {
             fa.bypass_change_detection().0 += f;
-            if let Some(mut t) = ta {
-                t.bypass_change_detection().0 += ra.cross(f);
-            }
         }
-        if let Ok((mut fb, tb)) = forces.get_mut(s.b) {
+        if let Ok(mut fb) = forces.get_mut(s.b) {
             fb.bypass_change_detection().0 -= f;
-            if let Some(mut t) = tb {
-                t.bypass_change_detection().0 -= rb.cross(f);
-            }
+        }
+        if ra != Vec3A::ZERO
+            && let Ok(mut t) = torques.get_mut(s.a)
+        {
+            t.bypass_change_detection().0 += ra.cross(f);
+        }
+        if rb != Vec3A::ZERO
+            && let Ok(mut t) = torques.get_mut(s.b)
+        {
+            t.bypass_change_detection().0 -= rb.cross(f);
         }
     }
 }
