@@ -39,13 +39,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (width, height) = (1000, 600);
     let mut top = Canvas::new(width, height, [0.0, -2.5, seconds, 2.5], [252, 252, 250]);
     let colors = [[200, 60, 60], [40, 120, 200], [60, 160, 80]];
-    for axis in 0..3 {
+    for (axis, color) in colors.into_iter().enumerate() {
+
         let pts: Vec<_> = samples
             .iter()
             .enumerate()
             .map(|(i, s)| (i as f32 / 60.0, s.0[axis] * 0.6 + 0.9))
             .collect();
-        top.polyline(&pts, 2, colors[axis]);
+        top.polyline(&pts, 2, color);
     }
     // Energy and |L| ratios, scaled so ±1 % fills the lower band.
     let band = |r: f32| -1.6 + (r - 1.0) * 50.0;
