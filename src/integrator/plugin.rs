@@ -65,7 +65,6 @@ type Live = Without<Quarantined>;
 /// Initialises every accumulator with the body's constant forces, f ← f_ext + m g s, and
 /// every torque accumulator with its constant torque, τ ← τ_ext.
 ///
-
 /// Gravity and external forces don't depend on the state, so they are written here in the one
 /// pass that has to touch every accumulator anyway; state-dependent forces are added in
 /// [`StepSystems::ApplyForces`]. Without the gravity plugin there is no [`Gravity`] resource
