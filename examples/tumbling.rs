@@ -40,7 +40,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut top = Canvas::new(width, height, [0.0, -2.5, seconds, 2.5], [252, 252, 250]);
     let colors = [[200, 60, 60], [40, 120, 200], [60, 160, 80]];
     for (axis, color) in colors.into_iter().enumerate() {
-
         let pts: Vec<_> = samples
             .iter()
             .enumerate()

@@ -64,7 +64,7 @@ pub struct PhysicsDiagnostics {
     /// Entity counts.
     pub counts: BodyCounts,
     /// Wall time per [`StepSystems`] set, in `StepSystems::ORDER`, summed over substeps.
-    pub set_times: [Duration; 8],
+    pub set_times: [Duration; 9],
     /// Wall time of the whole last step.
     pub step_time: Duration,
     /// Bodies quarantined since the world started.
@@ -114,14 +114,14 @@ impl Default for DiagnosticsSettings {
 #[derive(Resource, Default)]
 struct SetClock {
     last: Option<Instant>,
-    acc: [Duration; 8],
+    acc: [Duration; 9],
 }
 
 pub(crate) fn install(world: &mut World) {
     world.init_resource::<PhysicsDiagnostics>();
     world.init_resource::<DiagnosticsSettings>();
     world.init_resource::<SetClock>();
-    for k in 0..=8u8 {
+    for k in 0..=9u8 {
         add_systems(
             world,
             SubstepSchedule,

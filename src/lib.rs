@@ -46,6 +46,7 @@
 
 #![warn(missing_docs)]
 
+pub mod collision;
 pub mod diagnostics;
 pub mod error;
 pub mod integrator;
@@ -60,6 +61,10 @@ pub mod time;
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 
+pub use collision::{
+    Collider, CollisionLayers, CollisionPlugin, CombineRule, ContactEnded, ContactSettings,
+    ContactStarted, Contacts, Friction, Restitution, Sensor,
+};
 pub use diagnostics::{DiagnosticsSettings, PhysicsDiagnostics};
 pub use error::{Error, Result};
 pub use integrator::{ConstraintsActive, Integrator, IntegratorOverride, IntegratorPlugin};
@@ -126,7 +131,8 @@ impl Plugin for PhysicsCorePlugin {
     }
 }
 
-/// Every effect: core, gravity, damping, velocity fields, springs and rigid bodies.
+/// Every effect: core, gravity, damping, velocity fields, springs, rigid bodies and
+/// collisions.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct PhysicsPlugins;
 
@@ -137,7 +143,8 @@ impl Plugin for PhysicsPlugins {
             .add_physics(DampingPlugin)
             .add_physics(VelocityFieldPlugin)
             .add_physics(SpringPlugin)
-            .add_physics(RigidBodyPlugin);
+            .add_physics(RigidBodyPlugin)
+            .add_physics(CollisionPlugin);
     }
 }
 
@@ -172,6 +179,12 @@ fn mark_installed<P: Plugin>(world: &mut World) -> bool {
 /// Messages live for two rotations; see [`BodyQuarantined`].
 fn rotate_messages(world: &mut World) {
     if let Some(mut m) = world.get_resource_mut::<Messages<BodyQuarantined>>() {
+        m.update();
+    }
+    if let Some(mut m) = world.get_resource_mut::<Messages<ContactStarted>>() {
+        m.update();
+    }
+    if let Some(mut m) = world.get_resource_mut::<Messages<ContactEnded>>() {
         m.update();
     }
 }

@@ -13,6 +13,7 @@
 //!   StepSystems::IntegrateVelocities
 //!   StepSystems::SolveConstraints   contacts and joints act on velocities here
 //!   StepSystems::IntegratePositions
+//!   StepSystems::RelaxConstraints   contacts again without position bias (soft step)
 //!   StepSystems::CompleteStages     extra force evaluations of Verlet and RK4
 //!   StepSystems::Renormalize        unit quaternions
 //!
@@ -68,6 +69,9 @@ pub enum StepSystems {
     SolveConstraints,
     /// Positions advance from velocities; tracers are advected.
     IntegratePositions,
+    /// Contacts are solved once more without position bias, so that the push-out velocity
+    /// used to resolve penetration does not stay in the bodies (Box2D's soft step "relax").
+    RelaxConstraints,
     /// Verlet's second kick and RK4's stages, which re-run [`ForceSchedule`].
     CompleteStages,
     /// Orientations are renormalised to unit quaternions.
@@ -76,13 +80,14 @@ pub enum StepSystems {
 
 impl StepSystems {
     /// Every set in run order.
-    pub const ORDER: [StepSystems; 8] = [
+    pub const ORDER: [StepSystems; 9] = [
         StepSystems::ClearForces,
         StepSystems::ApplyForces,
         StepSystems::AccumulateTorque,
         StepSystems::IntegrateVelocities,
         StepSystems::SolveConstraints,
         StepSystems::IntegratePositions,
+        StepSystems::RelaxConstraints,
         StepSystems::CompleteStages,
         StepSystems::Renormalize,
     ];
@@ -111,6 +116,16 @@ pub enum IntegrationSystems {
     Impulses,
     /// The velocity phase of each integrator, linear and angular.
     Integrate,
+}
+
+/// The stages of [`PhysicsSystems::Prepare`]: user inputs first (kinematic targets, written
+/// velocities, broken springs), then collision detection, which reads the settled inputs.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PrepareSystems {
+    /// Inputs and bookkeeping.
+    Inputs,
+    /// Bounding boxes, broad phase, narrow phase, contact constraints.
+    Collision,
 }
 
 /// Timing probes between the step sets; probe k runs just before `StepSystems::ORDER[k]`.
@@ -142,6 +157,11 @@ pub(crate) fn init_schedules(world: &mut World) {
         )
             .chain(),
     );
+    physics.configure_sets(
+        (PrepareSystems::Inputs, PrepareSystems::Collision)
+            .chain()
+            .in_set(PhysicsSystems::Prepare),
+    );
 
     let mut substep = new_schedule(SubstepSchedule, false);
     substep.configure_sets(
@@ -159,10 +179,12 @@ pub(crate) fn init_schedules(world: &mut World) {
             ProbeSystems(5),
             StepSystems::IntegratePositions,
             ProbeSystems(6),
-            StepSystems::CompleteStages,
+            StepSystems::RelaxConstraints,
             ProbeSystems(7),
-            StepSystems::Renormalize,
+            StepSystems::CompleteStages,
             ProbeSystems(8),
+            StepSystems::Renormalize,
+            ProbeSystems(9),
         )
             .chain(),
     );

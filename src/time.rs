@@ -142,6 +142,18 @@ pub struct SubstepTime {
     pub h: f32,
     /// Simulated time at the start of this substep (s).
     pub t: f32,
+    /// Which substep of the step this is, from 0.
+    pub index: u32,
+    /// Substeps in the step.
+    pub count: u32,
+}
+
+impl SubstepTime {
+    /// True in the last substep of a step.
+    #[must_use]
+    pub fn is_last(&self) -> bool {
+        self.index + 1 >= self.count
+    }
 }
 
 /// What one call to `advance_physics` did.
@@ -172,7 +184,13 @@ pub(crate) fn run_substeps(world: &mut World, bodies: &mut QueryState<(), AnyBod
         }
         for i in 0..n {
             let t = (t0 + f64::from(h) * f64::from(i)) as f32;
-            *world.resource_mut::<SubstepTime>() = SubstepTime { h, t };
+            *world.resource_mut::<SubstepTime>() = SubstepTime {
+                h,
+                t,
+                index: i,
+                count: n,
+            };
+
             schedule.run(world);
         }
     });

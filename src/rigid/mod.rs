@@ -219,7 +219,15 @@ impl Inertia {
         f * glam::Mat3::from_diagonal(self.principal.into()) * f.transpose()
     }
 
+    /// The world inverse tensor I⁻¹ = R F diag(1/p) Fᵀ Rᵀ for orientation `q`.
+    #[must_use]
+    pub fn world_inverse_tensor(&self, q: Quat) -> glam::Mat3 {
+        let r = glam::Mat3::from_quat(unit(q) * self.frame);
+        r * glam::Mat3::from_diagonal(self.inverse.into()) * r.transpose()
+    }
+
     /// True for infinite inertia (a body torques cannot turn).
+
     #[must_use]
     pub fn is_infinite(&self) -> bool {
         self.inverse == Vec3A::ZERO

@@ -13,7 +13,7 @@ use crate::integrator::{Integrator, IntegratorOverride};
 use crate::particles::{Force, LinearVelocity, Position};
 use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::schedule::{
-    ForceSystems, IntegrationSystems, PhysicsSchedule, PhysicsSystems, StepSystems,
+    ForceSystems, IntegrationSystems, PhysicsSchedule, PrepareSystems, StepSystems,
     SubstepSchedule, add_force_systems, add_systems,
 };
 use crate::time::{PhysicsTime, SubstepTime};
@@ -38,7 +38,7 @@ impl Plugin for RigidBodyPlugin {
                 sync_angular_inputs.run_if(any_with_component::<Inertia>),
             )
                 .chain()
-                .in_set(PhysicsSystems::Prepare),
+                .in_set(PrepareSystems::Inputs),
         );
         add_force_systems(world, || {
             (

@@ -11,7 +11,7 @@ use glam::Vec3;
 
 use crate::rigid::{AngularVelocity, Rotation, Torque};
 use crate::schedule::{
-    ForceSystems, PhysicsSchedule, PhysicsSystems, add_force_systems, add_systems,
+    ForceSystems, PhysicsSchedule, PrepareSystems, add_force_systems, add_systems,
 };
 use crate::{Error, Plugin};
 
@@ -37,7 +37,7 @@ impl Plugin for SpringPlugin {
             PhysicsSchedule,
             remove_broken_springs
                 .run_if(any_with_component::<Spring>)
-                .in_set(PhysicsSystems::Prepare),
+                .in_set(PrepareSystems::Inputs),
         );
     }
 }

@@ -1,0 +1,385 @@
+//! Collisions through parry: colliders, broad phase, narrow phase and a soft-step contact
+//! solver.
+//!
+//! **Pipeline, once per step** (in [`crate::schedule::PrepareSystems::Collision`]):
+//! 1. bounding boxes of moving colliders, grown by the distance they can travel in the step
+//!    (the *speculative margin*, so fast bodies find what they would hit);
+//! 2. broad phase: sort-and-sweep on the axis along which the boxes spread most,
+//!    O(n log n); static pairs are never formed, and static boxes are recomputed only when
+//!    their pose or shape changes;
+//! 3. narrow phase: parry's persistent contact manifolds per pair, which carry each contact's
+//!    impulses from step to step by feature id (warm starting); contact start/end messages;
+//! 4. contact constraints with anchors, effective masses and the approach speed.
+//!
+//! **Solver, every substep** (Box2D v3's soft step): after the velocities are integrated,
+//! the contacts are warm-started and solved with a soft position bias (spring of
+//! [`ContactSettings::hertz`], damping ratio [`ContactSettings::damping_ratio`], push-out at
+//! most [`ContactSettings::max_push_velocity`]); positions are integrated; then
+//! [`crate::StepSystems::RelaxConstraints`] solves once more without bias so that the
+//! push-out does not stay in the velocities. After the last substep, restitution brings the
+//! normal velocity of every contact that hit faster than [`ContactSettings::restitution_threshold`]
+//! to −e times its approach speed. Friction is Coulomb's, a cone clamped to μ times the
+//! normal impulse. A separated contact (s > 0) is *speculative*: it only stops the approach
+//! from closing more than s in a substep, which is what keeps a fast small body from
+//! tunnelling through a thin wall.
+//!
+//! **Bodies.** A [`Collider`] on a body with a finite [`crate::Mass`] is dynamic; on a pinned
+//! or massless entity it is static (a kinematic body's velocity still drives its contacts).
+//! A particle with a ball collider collides like any body but never rotates.
+//!
+//! Units: m, s, kg; impulses in N·s.
+
+mod broad;
+mod narrow;
+mod plugin;
+mod solver;
+
+pub use narrow::{ContactPair, Contacts};
+pub use plugin::CollisionPlugin;
+
+use bevy_ecs::prelude::*;
+use glam::{Quat, Vec3};
+use parry3d::math::Pose;
+use parry3d::shape::SharedShape;
+
+use crate::error::{Error, Result, finite, finite_vec, non_negative};
+use crate::particles::Position;
+use crate::quarantine::{Validate, validate_on_insert};
+use crate::rigid::Rotation;
+
+/// A collision shape (a parry shape) attached to a body, placed at the body's shape frame:
+/// origin x − R c, where c is the [`crate::CenterOfMass`].
+#[derive(Component, Clone)]
+#[require(
+    Position,
+    Rotation,
+    Friction,
+    Restitution,
+    CollisionLayers,
+    ColliderAabb
+)]
+pub struct Collider {
+    shape: SharedShape,
+}
+
+impl std::fmt::Debug for Collider {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Collider({:?})", self.shape.shape_type())
+    }
+}
+
+impl Collider {
+    /// Wraps any parry shape after checking that its bounds are finite.
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`] for a shape with non-finite bounds.
+    pub fn new(shape: SharedShape) -> Result<Self> {
+        let aabb = shape.compute_local_aabb();
+        finite_vec("collider bounds", aabb.mins)?;
+        finite_vec("collider bounds", aabb.maxs)?;
+        Ok(Self { shape })
+    }
+
+    /// A ball of radius `r` (m).
+    ///
+    /// # Errors
+    /// [`Error::NotPositive`] unless `r` > 0.
+    pub fn ball(r: f32) -> Result<Self> {
+        Self::new(SharedShape::ball(positive_len("ball radius", r)?))
+    }
+
+    /// A box with half extents `hx`, `hy`, `hz` (m).
+    ///
+    /// # Errors
+    /// [`Error::NotPositive`] unless every half extent is > 0.
+    pub fn cuboid(hx: f32, hy: f32, hz: f32) -> Result<Self> {
+        Self::new(SharedShape::cuboid(
+            positive_len("half extent", hx)?,
+            positive_len("half extent", hy)?,
+            positive_len("half extent", hz)?,
+        ))
+    }
+
+    /// A capsule along y: a segment of half length `half_height` (m) swept by radius `r`.
+    ///
+    /// # Errors
+    /// [`Error::NotPositive`] for a non-positive radius or a negative half height.
+    pub fn capsule_y(half_height: f32, r: f32) -> Result<Self> {
+        non_negative("capsule half height", half_height)?;
+        Self::new(SharedShape::capsule_y(
+            half_height,
+            positive_len("capsule radius", r)?,
+        ))
+    }
+
+    /// A cylinder along y.
+    ///
+    /// # Errors
+    /// [`Error::NotPositive`] unless both sizes are > 0.
+    pub fn cylinder(half_height: f32, r: f32) -> Result<Self> {
+        Self::new(SharedShape::cylinder(
+            positive_len("cylinder half height", half_height)?,
+            positive_len("cylinder radius", r)?,
+        ))
+    }
+
+    /// The convex hull of `points` (m).
+    ///
+    /// # Errors
+    /// [`Error::TooFew`] when no hull exists (fewer than 4 points, or all coplanar).
+    pub fn convex_hull(points: &[Vec3]) -> Result<Self> {
+        for p in points {
+            finite_vec("hull point", *p)?;
+        }
+        let shape = SharedShape::convex_hull(points).ok_or(Error::TooFew {
+            what: "non-coplanar hull points",
+            min: 4,
+            got: points.len(),
+        })?;
+        Self::new(shape)
+    }
+
+    /// A triangle mesh (for static geometry; dynamic bodies should use convex parts).
+    ///
+    /// # Errors
+    /// [`Error::TooFew`] for an empty mesh, [`Error::IndexOutOfRange`] for a bad index.
+    pub fn trimesh(vertices: Vec<Vec3>, indices: Vec<[u32; 3]>) -> Result<Self> {
+        if indices.is_empty() {
+            return Err(Error::TooFew {
+                what: "triangles",
+                min: 1,
+                got: 0,
+            });
+        }
+        for i in indices.iter().flatten() {
+            if *i as usize >= vertices.len() {
+                return Err(Error::IndexOutOfRange {
+                    what: "triangle vertex",
+                    index: *i as usize,
+                    len: vertices.len(),
+                });
+            }
+        }
+        for v in &vertices {
+            finite_vec("mesh vertex", *v)?;
+        }
+        let shape = SharedShape::trimesh(vertices, indices).map_err(|_| Error::TooFew {
+            what: "valid triangles",
+            min: 1,
+            got: 0,
+        })?;
+        Self::new(shape)
+    }
+
+    /// A heightfield of `nrows` × `ncols` heights (row-major) scaled by `scale` (m).
+    ///
+    /// # Errors
+    /// [`Error::TooFew`] for fewer than 2 × 2 heights or a size mismatch.
+    pub fn heightfield(nrows: usize, ncols: usize, heights: Vec<f32>, scale: Vec3) -> Result<Self> {
+        if nrows < 2 || ncols < 2 || heights.len() != nrows * ncols {
+            return Err(Error::TooFew {
+                what: "heights (at least 2 × 2, rows × cols)",
+                min: 4,
+                got: heights.len(),
+            });
+        }
+        for h in &heights {
+            finite("height", *h)?;
+        }
+        finite_vec("heightfield scale", scale)?;
+        let grid = parry3d::utils::Array2::new(nrows, ncols, heights);
+        Self::new(SharedShape::heightfield(grid, scale))
+    }
+
+    /// Several colliders in one, each at a position and rotation in this shape's frame.
+    ///
+    /// # Errors
+    /// [`Error::TooFew`] for no parts, [`Error::NonFinite`] for bad poses.
+    pub fn compound(parts: Vec<(Vec3, Quat, Collider)>) -> Result<Self> {
+        if parts.is_empty() {
+            return Err(Error::TooFew {
+                what: "compound parts",
+                min: 1,
+                got: 0,
+            });
+        }
+        let mut shapes = Vec::with_capacity(parts.len());
+        for (x, q, c) in parts {
+            let q = Rotation::try_new(q)?.0;
+            shapes.push((
+                Pose::from_parts(finite_vec("part position", x)?, q),
+                c.shape,
+            ));
+        }
+        Self::new(SharedShape::compound(shapes))
+    }
+
+    /// The parry shape.
+    #[must_use]
+    pub fn shape(&self) -> &SharedShape {
+        &self.shape
+    }
+}
+
+fn positive_len(what: &'static str, v: f32) -> Result<f32> {
+    crate::error::positive(what, v)
+}
+
+/// Coulomb friction coefficient μ (dimensionless, default 0.5).
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = validate_on_insert::<Self>)]
+pub struct Friction(pub f32);
+
+impl Default for Friction {
+    fn default() -> Self {
+        Self(0.5)
+    }
+}
+
+impl Validate for Friction {
+    fn validate(&self) -> Result<()> {
+        non_negative("friction", self.0).map(|_| ())
+    }
+}
+
+/// Coefficient of restitution e in [0, 1] (default 0: no bounce).
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[component(on_insert = validate_on_insert::<Self>)]
+pub struct Restitution(pub f32);
+
+impl Validate for Restitution {
+    fn validate(&self) -> Result<()> {
+        let e = non_negative("restitution", self.0)?;
+        if e > 1.0 {
+            return Err(Error::NotPositive {
+                what: "1 - restitution (restitution above 1 adds energy)",
+                value: 1.0 - e,
+            });
+        }
+        Ok(())
+    }
+}
+
+/// How two colliders' coefficients combine into one for their contact.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CombineRule {
+    /// √(a b): the default for friction.
+    #[default]
+    GeometricMean,
+    /// (a + b) / 2.
+    Average,
+    /// min(a, b).
+    Min,
+    /// max(a, b): the default for restitution.
+    Max,
+    /// a b.
+    Multiply,
+}
+
+impl CombineRule {
+    /// Combines two coefficients.
+    #[must_use]
+    pub fn combine(self, a: f32, b: f32) -> f32 {
+        match self {
+            CombineRule::GeometricMean => (a * b).sqrt(),
+            CombineRule::Average => 0.5 * (a + b),
+            CombineRule::Min => a.min(b),
+            CombineRule::Max => a.max(b),
+            CombineRule::Multiply => a * b,
+        }
+    }
+}
+
+/// Which colliders may touch: a pair interacts when each one's `memberships` meets the
+/// other's `filters`. Default: every layer, colliding with every layer.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CollisionLayers {
+    /// Layers this collider is on (bit mask).
+    pub memberships: u32,
+    /// Layers this collider collides with (bit mask).
+    pub filters: u32,
+}
+
+impl Default for CollisionLayers {
+    fn default() -> Self {
+        Self {
+            memberships: u32::MAX,
+            filters: u32::MAX,
+        }
+    }
+}
+
+impl CollisionLayers {
+    /// True when the two colliders may interact.
+    #[must_use]
+    pub fn interacts(self, other: Self) -> bool {
+        self.memberships & other.filters != 0 && other.memberships & self.filters != 0
+    }
+}
+
+/// Marks a collider that reports overlaps (through [`Contacts`] and the contact messages)
+/// without pushing anything.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Sensor;
+
+/// The world bounding box of a collider as of the last step (m), grown by its speculative
+/// margin.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+pub struct ColliderAabb {
+    /// Lower corner.
+    pub min: Vec3,
+    /// Upper corner.
+    pub max: Vec3,
+}
+
+/// Contact solver settings (defaults are Box2D v3's).
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct ContactSettings {
+    /// Stiffness of the soft contact, as a frequency (Hz); capped at a quarter of the
+    /// substep rate.
+    pub hertz: f32,
+    /// Damping ratio of the soft contact (dimensionless; 10 is heavily overdamped).
+    pub damping_ratio: f32,
+    /// Fastest push-out speed for resolving penetration (m/s).
+    pub max_push_velocity: f32,
+    /// Approach speed below which restitution is ignored (m/s).
+    pub restitution_threshold: f32,
+    /// Extra margin around bounding boxes and in contact prediction (m).
+    pub margin: f32,
+    /// How frictions combine.
+    pub friction_rule: CombineRule,
+    /// How restitutions combine.
+    pub restitution_rule: CombineRule,
+}
+
+impl Default for ContactSettings {
+    fn default() -> Self {
+        Self {
+            hertz: 30.0,
+            damping_ratio: 10.0,
+            max_push_velocity: 3.0,
+            restitution_threshold: 1.0,
+            margin: 0.02,
+            friction_rule: CombineRule::GeometricMean,
+            restitution_rule: CombineRule::Max,
+        }
+    }
+}
+
+/// Written when two colliders start touching (or, with a sensor, overlapping).
+#[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ContactStarted {
+    /// One collider (the lower entity id).
+    pub a: Entity,
+    /// The other.
+    pub b: Entity,
+}
+
+/// Written when two colliders stop touching (or are despawned while touching).
+#[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ContactEnded {
+    /// One collider (the lower entity id).
+    pub a: Entity,
+    /// The other.
+    pub b: Entity,
+}

@@ -1,0 +1,478 @@
+//! Collision systems: bounding boxes, broad phase, narrow phase, contact solver.
+
+use bevy_ecs::prelude::*;
+use glam::{Mat3, Quat, Vec3, Vec3A};
+use parry3d::math::Pose;
+use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
+
+use super::broad::{BroadPhase, Entry};
+use super::narrow::{ContactImpulse, Contacts, PairState};
+use super::solver::{
+    ContactSolver, FIXED, ManifoldConstraint, PointConstraint, Softness, SolverBody, effective_mass,
+};
+use super::{
+    Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted,
+    Friction, Restitution, Sensor,
+};
+use crate::Plugin;
+use crate::integrator::ConstraintsActive;
+use crate::particles::{LinearVelocity, Mass, Position};
+use crate::quarantine::Quarantined;
+use crate::rigid::{AngularMomentum, AngularVelocity, CenterOfMass, Inertia, Rotation};
+use crate::schedule::{PhysicsSchedule, PrepareSystems, StepSystems, SubstepSchedule, add_systems};
+use crate::time::{PhysicsTime, SubstepTime};
+
+type Live = Without<Quarantined>;
+
+/// Colliders, contacts and the contact solver. Every system runs only while a collider
+/// exists; the solver only while some contact does.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct CollisionPlugin;
+
+impl Plugin for CollisionPlugin {
+    fn build(&self, world: &mut World) {
+        world.init_resource::<ContactSettings>();
+        world.init_resource::<BroadPhase>();
+        world.init_resource::<Contacts>();
+        world.init_resource::<ContactSolver>();
+        world.init_resource::<bevy_ecs::message::Messages<ContactStarted>>();
+        world.init_resource::<bevy_ecs::message::Messages<ContactEnded>>();
+        add_systems(
+            world,
+            PhysicsSchedule,
+            (
+                update_moving_aabbs,
+                update_fixed_aabbs,
+                run_broad_phase,
+                update_contacts,
+                prepare_contacts,
+            )
+                .chain()
+                .run_if(any_with_component::<Collider>)
+                .in_set(PrepareSystems::Collision),
+        );
+        add_systems(
+            world,
+            SubstepSchedule,
+            (
+                solve_contacts
+                    .run_if(contacts_active)
+                    .in_set(StepSystems::SolveConstraints),
+                relax_contacts
+                    .run_if(contacts_active)
+                    .in_set(StepSystems::RelaxConstraints),
+            ),
+        );
+    }
+}
+
+fn contacts_active(solver: Res<ContactSolver>) -> bool {
+    !solver.manifolds.is_empty()
+}
+
+/// The pose of a collider's shape frame: origin x − R c.
+fn shape_pose(x: Vec3A, q: Quat, com: Option<&CenterOfMass>) -> Pose {
+    let c = com.map_or(Vec3::ZERO, |c| c.0);
+    Pose::from_parts(Vec3::from(x) - q * c, q)
+}
+
+/// Bounding radius of a shape about the centre of mass (m).
+fn radius(collider: &Collider, com: Option<&CenterOfMass>) -> f32 {
+    let aabb = collider.shape().compute_local_aabb();
+    let c = com.map_or(Vec3::ZERO, |c| c.0);
+    (aabb.mins - c).length().max((aabb.maxs - c).length())
+}
+
+type MovingCollider<'a> = (
+    &'a Collider,
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    &'a LinearVelocity,
+    Option<&'a AngularVelocity>,
+    &'a mut ColliderAabb,
+);
+
+/// Boxes of moving colliders, grown by how far they can travel in a step.
+fn update_moving_aabbs(
+    time: Res<PhysicsTime>,
+    settings: Res<ContactSettings>,
+    mut colliders: Query<MovingCollider, Live>,
+) {
+    let dt = time.dt();
+    for (c, x, q, com, v, w, mut aabb) in &mut colliders {
+        let b = c.shape().compute_aabb(&shape_pose(x.0, q.0, com));
+        let spin = w.map_or(0.0, |w| w.0.length() * radius(c, com));
+        let grow = settings.margin + (v.0.length() + spin) * dt;
+        *aabb = ColliderAabb {
+            min: b.mins - Vec3::splat(grow),
+            max: b.maxs + Vec3::splat(grow),
+        };
+    }
+}
+
+type FixedChanged = (
+    Without<LinearVelocity>,
+    Or<(Changed<Position>, Changed<Rotation>, Changed<Collider>)>,
+    Live,
+);
+
+/// Boxes of fixed colliders: recomputed only when they were moved or reshaped.
+fn update_fixed_aabbs(
+    settings: Res<ContactSettings>,
+    mut colliders: Query<
+        (
+            &Collider,
+            &Position,
+            &Rotation,
+            Option<&CenterOfMass>,
+            &mut ColliderAabb,
+        ),
+        FixedChanged,
+    >,
+) {
+    for (c, x, q, com, mut aabb) in &mut colliders {
+        let b = c.shape().compute_aabb(&shape_pose(x.0, q.0, com));
+        *aabb = ColliderAabb {
+            min: b.mins - Vec3::splat(settings.margin),
+            max: b.maxs + Vec3::splat(settings.margin),
+        };
+    }
+}
+
+fn run_broad_phase(
+    mut bp: ResMut<BroadPhase>,
+    colliders: Query<
+        (Entity, &ColliderAabb, &CollisionLayers, Has<LinearVelocity>),
+        (With<Collider>, Live),
+    >,
+) {
+    bp.entries.clear();
+    for (entity, aabb, layers, moving) in &colliders {
+        bp.entries.push(Entry {
+            entity,
+            min: aabb.min,
+            max: aabb.max,
+            moving,
+            layers: *layers,
+        });
+    }
+    bp.find_pairs();
+}
+
+type NarrowCollider<'a> = (
+    &'a Collider,
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    Option<&'a LinearVelocity>,
+    Option<&'a AngularVelocity>,
+    Has<Sensor>,
+);
+
+/// Persistent manifolds for every candidate pair; start/end messages.
+fn update_contacts(
+    mut contacts: ResMut<Contacts>,
+    bp: Res<BroadPhase>,
+    time: Res<PhysicsTime>,
+    settings: Res<ContactSettings>,
+    colliders: Query<NarrowCollider, Live>,
+    mut started: MessageWriter<ContactStarted>,
+    mut ended: MessageWriter<ContactEnded>,
+) {
+    let dt = time.dt();
+    contacts.step += 1;
+    let step = contacts.step;
+    let touch = 0.25 * settings.margin;
+    for &(a, b) in &bp.pairs {
+        let (Ok(ca), Ok(cb)) = (colliders.get(a), colliders.get(b)) else {
+            continue;
+        };
+        let pose_a = shape_pose(ca.1.0, ca.2.0, ca.3);
+        let pose_b = shape_pose(cb.1.0, cb.2.0, cb.3);
+        let sensor = ca.6 || cb.6;
+        let state = contacts.pairs.entry((a, b)).or_insert_with(PairState::new);
+        state.seen = step;
+        state.sensor = sensor;
+        let touching = if sensor {
+            parry3d::query::intersection_test(&pose_a, &**ca.0.shape(), &pose_b, &**cb.0.shape())
+                .is_ok_and(|i| i.intersecting)
+        } else {
+            let speed =
+                |v: Option<&LinearVelocity>, w: Option<&AngularVelocity>, c: &Collider, com| {
+                    v.map_or(0.0, |v| v.0.length())
+                        + w.map_or(0.0, |w| w.0.length() * radius(c, com))
+                };
+            let prediction = settings.margin
+                + (speed(ca.4, ca.5, ca.0, ca.3) + speed(cb.4, cb.5, cb.0, cb.3)) * dt;
+            let pos12 = pose_a.inverse() * pose_b;
+            let result = DefaultQueryDispatcher.contact_manifolds(
+                &pos12,
+                &**ca.0.shape(),
+                &**cb.0.shape(),
+                prediction,
+                &mut state.manifolds,
+                &mut state.workspace,
+            );
+            if result.is_err() {
+                state.manifolds.clear();
+            }
+            state
+                .manifolds
+                .iter()
+                .flat_map(|m| &m.points)
+                .any(|p| p.dist < touch)
+        };
+        if touching != state.touching {
+            state.touching = touching;
+            if touching {
+                started.write(ContactStarted { a, b });
+            } else {
+                ended.write(ContactEnded { a, b });
+            }
+        }
+    }
+    let mut gone: Vec<_> = contacts
+        .pairs
+        .iter()
+        .filter(|(_, s)| s.seen != step)
+        .map(|(k, s)| (*k, s.touching))
+        .collect();
+    gone.sort_unstable_by_key(|g| g.0);
+    for ((a, b), touching) in gone {
+        contacts.pairs.remove(&(a, b));
+        if touching {
+            ended.write(ContactEnded { a, b });
+        }
+    }
+}
+
+type PreparedBody<'a> = (
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    Option<&'a Mass>,
+    Option<&'a LinearVelocity>,
+    Option<&'a Inertia>,
+    Option<&'a AngularVelocity>,
+    &'a Friction,
+    &'a Restitution,
+);
+
+/// Solver index of a collider's body: a new [`SolverBody`] for anything with a velocity,
+/// [`FIXED`] for static colliders.
+fn body_index(solver: &mut ContactSolver, e: Entity, b: &PreparedBody) -> u32 {
+    if let Some(&i) = solver.index.get(&e) {
+        return i;
+    }
+    let (x, q, _, mass, v, inertia, w, ..) = *b;
+    let (Some(mass), Some(v)) = (mass, v) else {
+        return FIXED;
+    };
+    let inv_i = inertia.map_or(Mat3::ZERO, |i| i.world_inverse_tensor(q.0));
+    let dynamic = !mass.is_pinned();
+    let i = solver.bodies.len() as u32;
+    solver.bodies.push(SolverBody {
+        entity: e,
+        inv_mass: mass.inverse(),
+        inv_i,
+        x0: x.0,
+        q0: q.0,
+        dx: Vec3A::ZERO,
+        dq: Quat::IDENTITY,
+        v: v.0,
+        w: w.map_or(Vec3A::ZERO, |w| w.0),
+        ang: Vec3A::ZERO,
+        dynamic,
+    });
+    solver.index.insert(e, i);
+    i
+}
+
+/// Turns this step's manifolds into contact constraints.
+fn prepare_contacts(
+    mut solver: ResMut<ContactSolver>,
+    mut active: ResMut<ConstraintsActive>,
+    contacts: Res<Contacts>,
+    bp: Res<BroadPhase>,
+    settings: Res<ContactSettings>,
+    bodies: Query<PreparedBody, (With<Collider>, Live)>,
+) {
+    let s = &mut *solver;
+    s.bodies.clear();
+    s.manifolds.clear();
+    s.points.clear();
+    s.index.clear();
+    for &(ea, eb) in &bp.pairs {
+        let Some(state) = contacts.pairs.get(&(ea, eb)) else {
+            continue;
+        };
+        if state.sensor || state.manifolds.iter().all(|m| m.points.is_empty()) {
+            continue;
+        }
+        let (Ok(a), Ok(b)) = (bodies.get(ea), bodies.get(eb)) else {
+            continue;
+        };
+        let (ia, ib) = (body_index(s, ea, &a), body_index(s, eb, &b));
+        if ia == FIXED && ib == FIXED {
+            continue;
+        }
+        let get = |s: &ContactSolver, i: u32| s.bodies.get(i as usize).copied();
+        let (ba, bb) = (get(s, ia), get(s, ib));
+        let (ma, mb) = (
+            ba.map_or(0.0, |b| b.inv_mass),
+            bb.map_or(0.0, |b| b.inv_mass),
+        );
+        let (iia, iib) = (
+            ba.map_or(Mat3::ZERO, |b| b.inv_i),
+            bb.map_or(Mat3::ZERO, |b| b.inv_i),
+        );
+        let (va, wa) = ba.map_or((Vec3A::ZERO, Vec3A::ZERO), |b| (b.v, b.w));
+        let (vb, wb) = bb.map_or((Vec3A::ZERO, Vec3A::ZERO), |b| (b.v, b.w));
+        let pose_a = shape_pose(a.0.0, a.1.0, a.2);
+        let pose_b = shape_pose(b.0.0, b.1.0, b.2);
+        let friction = settings.friction_rule.combine(a.7.0, b.7.0);
+        let restitution = settings.restitution_rule.combine(a.8.0, b.8.0);
+        for (mi, m) in state.manifolds.iter().enumerate() {
+            if m.points.is_empty() {
+                continue;
+            }
+            let n = Vec3A::from(pose_a.rotation * m.local_n1);
+            let (t0, t1) = Vec3::from(n).any_orthonormal_pair();
+            let t = [Vec3A::from(t0), Vec3A::from(t1)];
+            let first = s.points.len() as u32;
+            for p in &m.points {
+                let pa = Vec3A::from(pose_a * p.local_p1);
+                let pb = Vec3A::from(pose_b * p.local_p2);
+                let mid = 0.5 * (pa + pb);
+                let (r_a, r_b) = (mid - a.0.0, mid - b.0.0);
+                let rel = (vb + wb.cross(r_b)) - (va + wa.cross(r_a));
+                let tangent = Vec3A::from(p.data.tangent);
+                s.points.push(PointConstraint {
+                    r_a,
+                    r_b,
+                    base: p.dist - n.dot(r_b - r_a),
+                    n_mass: effective_mass(ma, &iia, r_a, mb, &iib, r_b, n),
+                    t_mass: [
+                        effective_mass(ma, &iia, r_a, mb, &iib, r_b, t[0]),
+                        effective_mass(ma, &iia, r_a, mb, &iib, r_b, t[1]),
+                    ],
+                    n_imp: p.data.normal,
+                    t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
+                    max_n: 0.0,
+                    approach: n.dot(rel),
+                });
+            }
+            s.manifolds.push(ManifoldConstraint {
+                a: ia,
+                b: ib,
+                n,
+                t,
+                friction,
+                restitution,
+                first,
+                count: s.points.len() as u32 - first,
+                pair: (ea, eb),
+                manifold: mi as u32,
+                fixed: ia == FIXED || ib == FIXED,
+            });
+        }
+    }
+    active.0 = !s.manifolds.is_empty();
+}
+
+type SolvedBody<'a> = (
+    &'a Position,
+    &'a Rotation,
+    &'a mut LinearVelocity,
+    Option<&'a mut AngularMomentum>,
+    Option<&'a Inertia>,
+    Option<&'a AngularVelocity>,
+);
+
+/// Reads the current state of every body in contact into the solver.
+fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
+    for b in &mut solver.bodies {
+        let Ok((x, q, v, l, inertia, w)) = bodies.get(b.entity) else {
+            continue;
+        };
+        b.dx = x.0 - b.x0;
+        b.dq = q.0 * b.q0.inverse();
+        b.v = v.0;
+        b.w = match (inertia, l) {
+            (Some(i), Some(l)) if !i.is_infinite() => i.angular_velocity(q.0, l.0),
+            _ => w.map_or(Vec3A::ZERO, |w| w.0),
+        };
+        b.ang = Vec3A::ZERO;
+    }
+}
+
+/// Writes the solved velocities back: v directly, and L += Σ r × P (so ω = I⁻¹L follows).
+fn scatter(solver: &ContactSolver, bodies: &mut Query<SolvedBody, Live>) {
+    for b in &solver.bodies {
+        if !b.dynamic {
+            continue;
+        }
+        if let Ok((_, _, mut v, l, ..)) = bodies.get_mut(b.entity) {
+            v.0 = b.v;
+            if let Some(mut l) = l {
+                l.bypass_change_detection().0 += b.ang;
+            }
+        }
+    }
+}
+
+fn softness(settings: &ContactSettings, h: f32) -> (Softness, Softness) {
+    let hertz = settings.hertz.min(0.25 / h);
+    (
+        Softness::new(hertz, settings.damping_ratio, h),
+        Softness::new(2.0 * hertz, settings.damping_ratio, h),
+    )
+}
+
+/// Warm start, then one biased pass.
+fn solve_contacts(
+    mut solver: ResMut<ContactSolver>,
+    time: Res<SubstepTime>,
+    settings: Res<ContactSettings>,
+    mut bodies: Query<SolvedBody, Live>,
+) {
+    gather(&mut solver, &bodies);
+    let (soft, fixed) = softness(&settings, time.h);
+    solver.warm_start();
+    solver.solve(time.h, soft, fixed, true, settings.max_push_velocity);
+    scatter(&solver, &mut bodies);
+}
+
+/// One pass without bias; after the last substep, restitution and the impulses kept for
+/// the next step's warm start.
+fn relax_contacts(
+    mut solver: ResMut<ContactSolver>,
+    mut contacts: ResMut<Contacts>,
+    time: Res<SubstepTime>,
+    settings: Res<ContactSettings>,
+    mut bodies: Query<SolvedBody, Live>,
+) {
+    gather(&mut solver, &bodies);
+    let (soft, fixed) = softness(&settings, time.h);
+    solver.solve(time.h, soft, fixed, false, settings.max_push_velocity);
+    if time.is_last() {
+        solver.restitution(settings.restitution_threshold);
+        for m in &solver.manifolds {
+            let Some(state) = contacts.pairs.get_mut(&m.pair) else {
+                continue;
+            };
+            let Some(manifold) = state.manifolds.get_mut(m.manifold as usize) else {
+                continue;
+            };
+            let points = &solver.points[m.first as usize..(m.first + m.count) as usize];
+            for (tracked, p) in manifold.points.iter_mut().zip(points) {
+                tracked.data = ContactImpulse {
+                    normal: p.n_imp,
+                    tangent: (p.t_imp[0] * m.t[0] + p.t_imp[1] * m.t[1]).into(),
+                };
+            }
+        }
+    }
+    scatter(&solver, &mut bodies);
+}

@@ -1,0 +1,324 @@
+//! The soft-step contact solver (after Box2D v3, extended to 3D friction).
+//!
+//! Per contact point, with normal n from a to b, lever arms r_a, r_b from the centres of
+//! mass and relative normal velocity v_n:
+//!
+//! ```text
+//! m_n = 1 / (1/m_a + 1/m_b + n·(I_a⁻¹(r_a×n))×r_a + n·(I_b⁻¹(r_b×n))×r_b)
+//! s > 0 (speculative):  λ = −m_n (v_n + s/h)
+//! s ≤ 0, with bias:     λ = −m_n·S_m (v_n + max(β s, −v_push)) − S_i λ_acc
+//! ```
+//!
+//! with the soft-constraint coefficients of a spring of frequency f and damping ratio ζ,
+//! ω = 2πf: a₁ = 2ζ + hω, a₂ = hω a₁, β = ω/a₁, S_m = a₂/(1 + a₂), S_i = 1/(1 + a₂). The
+//! accumulated normal impulse stays ≥ 0; friction clamps the tangent impulse vector to
+//! μ λ_n.
+
+use std::collections::HashMap;
+
+use bevy_ecs::prelude::*;
+use glam::{Mat3, Quat, Vec3A};
+
+/// Index of the immovable "body" that stands for every static collider.
+pub(crate) const FIXED: u32 = u32::MAX;
+
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct SolverBody {
+    pub entity: Entity,
+    pub inv_mass: f32,
+    /// World inverse inertia at the start of the step.
+    pub inv_i: Mat3,
+    /// Centre of mass and rotation at the start of the step.
+    pub x0: Vec3A,
+    pub q0: Quat,
+    /// Displacement and rotation since the start of the step.
+    pub dx: Vec3A,
+    pub dq: Quat,
+    pub v: Vec3A,
+    pub w: Vec3A,
+    /// Σ r × P applied during the current pass: added to L on scatter.
+    pub ang: Vec3A,
+    /// False for kinematic bodies: they drive contacts but are never pushed.
+    pub dynamic: bool,
+}
+
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct PointConstraint {
+    pub r_a: Vec3A,
+    pub r_b: Vec3A,
+    /// Separation minus n·(r_b − r_a) at the start: the current separation is
+    /// n·(Δx_b + R_b r_b − Δx_a − R_a r_a) + base.
+    pub base: f32,
+    pub n_mass: f32,
+    pub t_mass: [f32; 2],
+    pub n_imp: f32,
+    pub t_imp: [f32; 2],
+    pub max_n: f32,
+    /// Relative normal velocity at the start of the step (negative when approaching).
+    pub approach: f32,
+}
+
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct ManifoldConstraint {
+    pub a: u32,
+    pub b: u32,
+    pub n: Vec3A,
+    pub t: [Vec3A; 2],
+    pub friction: f32,
+    pub restitution: f32,
+    pub first: u32,
+    pub count: u32,
+    pub pair: (Entity, Entity),
+    pub manifold: u32,
+    /// One side is fixed: use the stiffer static softness.
+    pub fixed: bool,
+}
+
+/// The step's contact constraints and the bodies they touch.
+#[derive(Resource, Default)]
+pub(crate) struct ContactSolver {
+    pub bodies: Vec<SolverBody>,
+    pub manifolds: Vec<ManifoldConstraint>,
+    pub points: Vec<PointConstraint>,
+    pub index: HashMap<Entity, u32>,
+}
+
+/// The soft-constraint coefficients for frequency `hertz`, damping ratio `zeta` and step `h`.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Softness {
+    pub bias_rate: f32,
+    pub mass_scale: f32,
+    pub impulse_scale: f32,
+}
+
+impl Softness {
+    #[must_use]
+    pub fn new(hertz: f32, zeta: f32, h: f32) -> Self {
+        if hertz <= 0.0 {
+            return Self {
+                bias_rate: 0.0,
+                mass_scale: 1.0,
+                impulse_scale: 0.0,
+            };
+        }
+        let omega = std::f32::consts::TAU * hertz;
+        let a1 = 2.0 * zeta + h * omega;
+        let a2 = h * omega * a1;
+        let a3 = 1.0 / (1.0 + a2);
+        Self {
+            bias_rate: omega / a1,
+            mass_scale: a2 * a3,
+            impulse_scale: a3,
+        }
+    }
+}
+
+/// 1 / (1/m_a + 1/m_b + d·(I_a⁻¹(r_a×d))×r_a + d·(I_b⁻¹(r_b×d))×r_b), or 0 when nothing can move.
+pub(crate) fn effective_mass(
+    ma: f32,
+    ia: &Mat3,
+    ra: Vec3A,
+    mb: f32,
+    ib: &Mat3,
+    rb: Vec3A,
+    d: Vec3A,
+) -> f32 {
+    let ca = Vec3A::from(*ia * glam::Vec3::from(ra.cross(d))).cross(ra);
+    let cb = Vec3A::from(*ib * glam::Vec3::from(rb.cross(d))).cross(rb);
+    let k = ma + mb + d.dot(ca + cb);
+    if k > 0.0 { 1.0 / k } else { 0.0 }
+}
+
+struct Side {
+    v: Vec3A,
+    w: Vec3A,
+    inv_m: f32,
+    inv_i: Mat3,
+    dx: Vec3A,
+    dq: Quat,
+    ang: Vec3A,
+}
+
+impl ContactSolver {
+    fn side(&self, i: u32) -> Side {
+        match self.bodies.get(i as usize) {
+            Some(b) => Side {
+                v: b.v,
+                w: b.w,
+                inv_m: if b.dynamic { b.inv_mass } else { 0.0 },
+                inv_i: if b.dynamic { b.inv_i } else { Mat3::ZERO },
+                dx: b.dx,
+                dq: b.dq,
+                ang: b.ang,
+            },
+            None => Side {
+                v: Vec3A::ZERO,
+                w: Vec3A::ZERO,
+                inv_m: 0.0,
+                inv_i: Mat3::ZERO,
+                dx: Vec3A::ZERO,
+                dq: Quat::IDENTITY,
+                ang: Vec3A::ZERO,
+            },
+        }
+    }
+
+    fn store(&mut self, i: u32, s: &Side) {
+        if let Some(b) = self.bodies.get_mut(i as usize)
+            && b.dynamic
+        {
+            b.v = s.v;
+            b.w = s.w;
+            b.ang = s.ang;
+        }
+    }
+
+    /// Applies impulse `p` at lever arms (r_a, r_b): −p to a, +p to b.
+    #[inline]
+    fn apply(a: &mut Side, b: &mut Side, ra: Vec3A, rb: Vec3A, p: Vec3A) {
+        let la = ra.cross(p);
+        let lb = rb.cross(p);
+        a.v -= a.inv_m * p;
+        a.w -= Vec3A::from(a.inv_i * glam::Vec3::from(la));
+        a.ang -= la;
+        b.v += b.inv_m * p;
+        b.w += Vec3A::from(b.inv_i * glam::Vec3::from(lb));
+        b.ang += lb;
+    }
+
+    /// Applies every accumulated impulse once (warm start).
+    pub fn warm_start(&mut self) {
+        for mi in 0..self.manifolds.len() {
+            let m = self.manifolds[mi];
+            let (mut a, mut b) = (self.side(m.a), self.side(m.b));
+            for p in &self.points[m.first as usize..(m.first + m.count) as usize] {
+                let imp = p.n_imp * m.n + p.t_imp[0] * m.t[0] + p.t_imp[1] * m.t[1];
+                Self::apply(&mut a, &mut b, p.r_a, p.r_b, imp);
+            }
+            self.store(m.a, &a);
+            self.store(m.b, &b);
+        }
+    }
+
+    /// One pass over every contact: normal impulses (with the soft bias when `use_bias`),
+    /// then friction.
+    pub fn solve(
+        &mut self,
+        h: f32,
+        soft: Softness,
+        fixed_soft: Softness,
+        use_bias: bool,
+        max_push: f32,
+    ) {
+        let inv_h = 1.0 / h;
+        for mi in 0..self.manifolds.len() {
+            let m = self.manifolds[mi];
+            let (mut a, mut b) = (self.side(m.a), self.side(m.b));
+            let soft = if m.fixed { fixed_soft } else { soft };
+            let range = m.first as usize..(m.first + m.count) as usize;
+            for p in &mut self.points[range.clone()] {
+                let d = (b.dx - a.dx) + (b.dq * p.r_b - a.dq * p.r_a);
+                let s = m.n.dot(d) + p.base;
+                let (bias, mass_scale, impulse_scale) = if s > 0.0 {
+                    (s * inv_h, 1.0, 0.0)
+                } else if use_bias {
+                    (
+                        (soft.bias_rate * s).max(-max_push),
+                        soft.mass_scale,
+                        soft.impulse_scale,
+                    )
+                } else {
+                    (0.0, 1.0, 0.0)
+                };
+                let vn = m.n.dot((b.v + b.w.cross(p.r_b)) - (a.v + a.w.cross(p.r_a)));
+                let imp = -p.n_mass * mass_scale * (vn + bias) - impulse_scale * p.n_imp;
+                let total = (p.n_imp + imp).max(0.0);
+                let imp = total - p.n_imp;
+                p.n_imp = total;
+                p.max_n = p.max_n.max(imp);
+                Self::apply(&mut a, &mut b, p.r_a, p.r_b, imp * m.n);
+            }
+            for p in &mut self.points[range] {
+                let dv = (b.v + b.w.cross(p.r_b)) - (a.v + a.w.cross(p.r_a));
+                let old = p.t_imp;
+                let mut new = [
+                    old[0] - p.t_mass[0] * m.t[0].dot(dv),
+                    old[1] - p.t_mass[1] * m.t[1].dot(dv),
+                ];
+                // Coulomb cone: |λ_t| ≤ μ λ_n.
+                let limit = m.friction * p.n_imp;
+                let len = (new[0] * new[0] + new[1] * new[1]).sqrt();
+                if len > limit && len > 0.0 {
+                    let s = limit / len;
+                    new = [new[0] * s, new[1] * s];
+                }
+                p.t_imp = new;
+                let imp = (new[0] - old[0]) * m.t[0] + (new[1] - old[1]) * m.t[1];
+                Self::apply(&mut a, &mut b, p.r_a, p.r_b, imp);
+            }
+            self.store(m.a, &a);
+            self.store(m.b, &b);
+        }
+    }
+
+    /// After the last substep: contacts that hit faster than `threshold` leave at −e times
+    /// their approach speed.
+    pub fn restitution(&mut self, threshold: f32) {
+        for mi in 0..self.manifolds.len() {
+            let m = self.manifolds[mi];
+            if m.restitution == 0.0 {
+                continue;
+            }
+            let (mut a, mut b) = (self.side(m.a), self.side(m.b));
+            for p in &mut self.points[m.first as usize..(m.first + m.count) as usize] {
+                if p.approach > -threshold || p.max_n == 0.0 {
+                    continue;
+                }
+                let vn = m.n.dot((b.v + b.w.cross(p.r_b)) - (a.v + a.w.cross(p.r_a)));
+                let imp = -p.n_mass * (vn + m.restitution * p.approach);
+                let total = (p.n_imp + imp).max(0.0);
+                let imp = total - p.n_imp;
+                p.n_imp = total;
+                Self::apply(&mut a, &mut b, p.r_a, p.r_b, imp * m.n);
+            }
+            self.store(m.a, &a);
+            self.store(m.b, &b);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn softness_matches_box2d_coefficients() {
+        // f = 30 Hz, ζ = 10, h = 1/240: ω = 188.5, a1 = 20.785, a2 = 16.32.
+        let s = Softness::new(30.0, 10.0, 1.0 / 240.0);
+        let omega = std::f32::consts::TAU * 30.0;
+        let a1 = 20.0 + omega / 240.0;
+        let a2 = omega / 240.0 * a1;
+        assert!((s.bias_rate - omega / a1).abs() < 1e-4);
+        assert!((s.mass_scale - a2 / (1.0 + a2)).abs() < 1e-6);
+        assert!((s.impulse_scale - 1.0 / (1.0 + a2)).abs() < 1e-6);
+        assert_eq!(Softness::new(0.0, 1.0, 0.01).mass_scale, 1.0);
+    }
+
+    #[test]
+    fn effective_mass_of_a_point_mass_and_a_lever() {
+        let z = Mat3::ZERO;
+        assert_eq!(
+            effective_mass(0.5, &z, Vec3A::ZERO, 0.0, &z, Vec3A::ZERO, Vec3A::Y),
+            2.0
+        );
+        // A unit-inertia body hit at r = x along y: k = 1/m + |r × n|² / I = 1 + 1.
+        let i = Mat3::IDENTITY;
+        assert!(
+            (effective_mass(1.0, &i, Vec3A::X, 0.0, &z, Vec3A::ZERO, Vec3A::Y) - 0.5).abs() < 1e-6
+        );
+        assert_eq!(
+            effective_mass(0.0, &z, Vec3A::X, 0.0, &z, Vec3A::X, Vec3A::Y),
+            0.0
+        );
+    }
+}
