@@ -98,15 +98,17 @@ mod tests {
 
     #[test]
     fn finds_exactly_the_overlapping_moving_pairs() {
-        let mut bp = BroadPhase::default();
-        bp.entries = vec![
-            entry(1, Vec3::ZERO, Vec3::ONE, true),
-            entry(2, Vec3::splat(0.5), Vec3::splat(1.5), true),
-            entry(3, Vec3::splat(3.0), Vec3::splat(4.0), true),
-            entry(4, Vec3::new(0.5, 5.0, 0.5), Vec3::new(0.9, 6.0, 0.9), true),
-            entry(5, Vec3::splat(-10.0), Vec3::splat(10.0), false),
-            entry(6, Vec3::splat(-1.0), Vec3::splat(0.2), false),
-        ];
+        let mut bp = BroadPhase {
+            entries: vec![
+                entry(1, Vec3::ZERO, Vec3::ONE, true),
+                entry(2, Vec3::splat(0.5), Vec3::splat(1.5), true),
+                entry(3, Vec3::splat(3.0), Vec3::splat(4.0), true),
+                entry(4, Vec3::new(0.5, 5.0, 0.5), Vec3::new(0.9, 6.0, 0.9), true),
+                entry(5, Vec3::splat(-10.0), Vec3::splat(10.0), false),
+                entry(6, Vec3::splat(-1.0), Vec3::splat(0.2), false),
+            ],
+            pairs: Vec::new(),
+        };
         bp.find_pairs();
         // Entity order is bevy's, not the index order: compare as sorted index pairs.
         let mut ids: Vec<(u32, u32)> = bp

@@ -140,12 +140,16 @@ fn update_fixed_aabbs(
     }
 }
 
+type BroadCollider<'a> = (
+    Entity,
+    &'a ColliderAabb,
+    &'a CollisionLayers,
+    Has<LinearVelocity>,
+);
+
 fn run_broad_phase(
     mut bp: ResMut<BroadPhase>,
-    colliders: Query<
-        (Entity, &ColliderAabb, &CollisionLayers, Has<LinearVelocity>),
-        (With<Collider>, Live),
-    >,
+    colliders: Query<BroadCollider, (With<Collider>, Live)>,
 ) {
     bp.entries.clear();
     for (entity, aabb, layers, moving) in &colliders {

@@ -227,7 +227,6 @@ impl Inertia {
     }
 
     /// True for infinite inertia (a body torques cannot turn).
-
     #[must_use]
     pub fn is_infinite(&self) -> bool {
         self.inverse == Vec3A::ZERO
