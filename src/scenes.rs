@@ -165,3 +165,138 @@ pub fn tumbling_boxes(world: &mut World, n: usize) -> Result<()> {
     world.spawn_batch(batch);
     Ok(())
 }
+
+/// A static ground box whose top face is the plane y = 0, 100 m × 100 m.
+///
+/// # Errors
+/// None in practice.
+pub fn ground(world: &mut World) -> Result<Entity> {
+    Ok(world
+        .spawn((
+            crate::RigidBodyBundle::fixed(Vec3::new(0.0, -0.5, 0.0), glam::Quat::IDENTITY)?,
+            crate::Collider::cuboid(50.0, 0.5, 50.0)?,
+        ))
+        .id())
+}
+
+/// A dynamic box with half extents `half` (m) and density 1000 kg/m³ at `x`.
+///
+/// # Errors
+/// Constructor errors for bad sizes.
+pub fn dynamic_box(world: &mut World, half: Vec3, x: Vec3) -> Result<Entity> {
+    let collider = crate::Collider::cuboid(half.x, half.y, half.z)?;
+    let props = crate::MassProperties::from_shape(&**collider.shape(), 1000.0)?;
+    Ok(world
+        .spawn((crate::RigidBodyBundle::dynamic(props)?.at(x)?, collider))
+        .id())
+}
+
+/// A dynamic ball of radius `r` (m), density 1000 kg/m³, at `x`.
+///
+/// # Errors
+/// Constructor errors for bad sizes.
+pub fn dynamic_ball(world: &mut World, r: f32, x: Vec3) -> Result<Entity> {
+    let collider = crate::Collider::ball(r)?;
+    let props = crate::MassProperties::from_shape(&**collider.shape(), 1000.0)?;
+    Ok(world
+        .spawn((crate::RigidBodyBundle::dynamic(props)?.at(x)?, collider))
+        .id())
+}
+
+/// Rapier's "boxes" scene: `n` × `n` columns of `n` unit boxes (half extent 0.5 m) on the
+/// ground, columns 1.5 m apart. Returns the boxes, bottom layer first.
+///
+/// # Errors
+/// Constructor errors (none with these values).
+pub fn box_stack(world: &mut World, n: usize) -> Result<Vec<Entity>> {
+    ground(world)?;
+    let mut out = Vec::with_capacity(n * n * n);
+    let offset = (n as f32 - 1.0) * 0.75;
+    for layer in 0..n {
+        for i in 0..n {
+            for k in 0..n {
+                let x = Vec3::new(
+                    i as f32 * 1.5 - offset,
+                    0.5 + layer as f32,
+                    k as f32 * 1.5 - offset,
+                );
+                out.push(dynamic_box(world, Vec3::splat(0.5), x)?);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// A pyramid of `layers` rows of unit boxes in one plane (layers·(layers+1)/2 boxes).
+///
+/// # Errors
+/// Constructor errors (none with these values).
+pub fn pyramid(world: &mut World, layers: usize) -> Result<Vec<Entity>> {
+    ground(world)?;
+    let mut out = Vec::new();
+    for row in 0..layers {
+        let count = layers - row;
+        for i in 0..count {
+            let x = (i as f32 - (count as f32 - 1.0) / 2.0) * 1.05;
+            out.push(dynamic_box(
+                world,
+                Vec3::splat(0.5),
+                Vec3::new(x, 0.5 + row as f32, 0.0),
+            )?);
+        }
+    }
+    Ok(out)
+}
+
+/// `n` unit boxes falling from a lattice 2 m apart (lowest 2 m above the ground), slightly
+/// turned so they tumble.
+///
+/// # Errors
+/// Constructor errors (none with these values).
+pub fn falling_boxes(world: &mut World, n: usize) -> Result<Vec<Entity>> {
+    ground(world)?;
+    let side = (n as f32).sqrt().ceil() as usize;
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let (a, b) = (i % side, i / side);
+        let layer = i / (side * side);
+        let x = Vec3::new(
+            (a as f32 - side as f32 / 2.0) * 1.2,
+            2.5 + layer as f32 * 1.2,
+            ((b % side) as f32 - side as f32 / 2.0) * 1.2,
+        );
+        let e = dynamic_box(world, Vec3::splat(0.5), x)?;
+        let q = glam::Quat::from_scaled_axis(jitter(i) * 0.3);
+        if let Some(mut r) = world.get_mut::<crate::Rotation>(e) {
+            r.0 = q;
+        }
+        out.push(e);
+    }
+    Ok(out)
+}
+
+/// A heap: `n` unit boxes in columns 1.1 m apart and layers 1.3 m apart (about ∛n of each),
+/// each turned by up to 0.3 rad, dropped onto the ground and onto each other.
+///
+/// # Errors
+/// Constructor errors (none with these values).
+pub fn box_pile(world: &mut World, n: usize) -> Result<Vec<Entity>> {
+    ground(world)?;
+    let side = (n as f32).cbrt().ceil() as usize;
+    let mut out = Vec::with_capacity(n);
+    for i in 0..n {
+        let (a, b, layer) = (i % side, (i / side) % side, i / (side * side));
+        let half = side as f32 / 2.0;
+        let x = Vec3::new(
+            (a as f32 - half) * 1.1,
+            1.0 + layer as f32 * 1.3,
+            (b as f32 - half) * 1.1,
+        );
+        let e = dynamic_box(world, Vec3::splat(0.5), x)?;
+        if let Some(mut r) = world.get_mut::<crate::Rotation>(e) {
+            r.0 = glam::Quat::from_scaled_axis(jitter(i) * 0.3);
+        }
+        out.push(e);
+    }
+    Ok(out)
+}

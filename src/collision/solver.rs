@@ -200,8 +200,11 @@ impl ContactSolver {
         }
     }
 
-    /// One pass over every contact: normal impulses (with the soft bias when `use_bias`),
-    /// then friction.
+    /// One pass over every contact: normal impulses (with the soft bias when `use_bias`) and
+    /// friction. With the bias, friction goes first: the soft normal solve relaxes the
+    /// accumulated normal impulse by S_i, and a friction limit taken from that relaxed value
+    /// lets bodies creep down slopes (measured: 7 % too little friction on a 30° incline). The
+    /// relax pass solves the normal first, so its friction sees the full normal impulse.
     pub fn solve(
         &mut self,
         h: f32,
@@ -216,6 +219,9 @@ impl ContactSolver {
             let (mut a, mut b) = (self.side(m.a), self.side(m.b));
             let soft = if m.fixed { fixed_soft } else { soft };
             let range = m.first as usize..(m.first + m.count) as usize;
+            if use_bias {
+                Self::friction(&m, &mut self.points[range.clone()], &mut a, &mut b);
+            }
             for p in &mut self.points[range.clone()] {
                 let d = (b.dx - a.dx) + (b.dq * p.r_b - a.dq * p.r_a);
                 let s = m.n.dot(d) + p.base;
@@ -234,30 +240,46 @@ impl ContactSolver {
                 let imp = -p.n_mass * mass_scale * (vn + bias) - impulse_scale * p.n_imp;
                 let total = (p.n_imp + imp).max(0.0);
                 let imp = total - p.n_imp;
+                if p.max_n == 0.0 && imp > 0.0 {
+                    // The first push of the step: vn is the speed of impact, which a
+                    // speculative contact reaches up to a step after the step began.
+                    p.approach = p.approach.min(vn);
+                }
                 p.n_imp = total;
                 p.max_n = p.max_n.max(imp);
                 Self::apply(&mut a, &mut b, p.r_a, p.r_b, imp * m.n);
             }
-            for p in &mut self.points[range] {
-                let dv = (b.v + b.w.cross(p.r_b)) - (a.v + a.w.cross(p.r_a));
-                let old = p.t_imp;
-                let mut new = [
-                    old[0] - p.t_mass[0] * m.t[0].dot(dv),
-                    old[1] - p.t_mass[1] * m.t[1].dot(dv),
-                ];
-                // Coulomb cone: |λ_t| ≤ μ λ_n.
-                let limit = m.friction * p.n_imp;
-                let len = (new[0] * new[0] + new[1] * new[1]).sqrt();
-                if len > limit && len > 0.0 {
-                    let s = limit / len;
-                    new = [new[0] * s, new[1] * s];
-                }
-                p.t_imp = new;
-                let imp = (new[0] - old[0]) * m.t[0] + (new[1] - old[1]) * m.t[1];
-                Self::apply(&mut a, &mut b, p.r_a, p.r_b, imp);
+            if !use_bias {
+                Self::friction(&m, &mut self.points[range], &mut a, &mut b);
             }
             self.store(m.a, &a);
             self.store(m.b, &b);
+        }
+    }
+
+    /// Coulomb friction for one manifold: the tangent impulse vector clamped to μ λ_n.
+    fn friction(
+        m: &ManifoldConstraint,
+        points: &mut [PointConstraint],
+        a: &mut Side,
+        b: &mut Side,
+    ) {
+        for p in points {
+            let dv = (b.v + b.w.cross(p.r_b)) - (a.v + a.w.cross(p.r_a));
+            let old = p.t_imp;
+            let mut new = [
+                old[0] - p.t_mass[0] * m.t[0].dot(dv),
+                old[1] - p.t_mass[1] * m.t[1].dot(dv),
+            ];
+            let limit = m.friction * p.n_imp;
+            let len = (new[0] * new[0] + new[1] * new[1]).sqrt();
+            if len > limit && len > 0.0 {
+                let s = limit / len;
+                new = [new[0] * s, new[1] * s];
+            }
+            p.t_imp = new;
+            let imp = (new[0] - old[0]) * m.t[0] + (new[1] - old[1]) * m.t[1];
+            Self::apply(a, b, p.r_a, p.r_b, imp);
         }
     }
 
