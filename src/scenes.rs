@@ -166,15 +166,16 @@ pub fn tumbling_boxes(world: &mut World, n: usize) -> Result<()> {
     Ok(())
 }
 
-/// A static ground box whose top face is the plane y = 0, 100 m × 100 m.
+/// A static ground box whose top face is the plane y = 0, 100 m × 100 m ([`BoxSpec::ground`]).
 ///
 /// # Errors
 /// None in practice.
 pub fn ground(world: &mut World) -> Result<Entity> {
+    let g = BoxSpec::ground();
     Ok(world
         .spawn((
-            crate::RigidBodyBundle::fixed(Vec3::new(0.0, -0.5, 0.0), glam::Quat::IDENTITY)?,
-            crate::Collider::cuboid(50.0, 0.5, 50.0)?,
+            crate::RigidBodyBundle::fixed(g.position, g.rotation)?,
+            crate::Collider::cuboid(g.half.x, g.half.y, g.half.z)?,
         ))
         .id())
 }
@@ -203,14 +204,70 @@ pub fn dynamic_ball(world: &mut World, r: f32, x: Vec3) -> Result<Entity> {
         .id())
 }
 
-/// Rapier's "boxes" scene: `n` × `n` columns of `n` unit boxes (half extent 0.5 m) on the
-/// ground, columns 1.5 m apart. Returns the boxes, bottom layer first.
+/// One box of a contact scene, so that hooke and a reference engine build the same bodies.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoxSpec {
+    /// Half extents (m).
+    pub half: Vec3,
+    /// Centre (m).
+    pub position: Vec3,
+    /// Orientation.
+    pub rotation: glam::Quat,
+    /// Static (true) or dynamic with density 1000 kg/m³.
+    pub fixed: bool,
+}
+
+impl BoxSpec {
+    fn dynamic(half: Vec3, position: Vec3) -> Self {
+        Self {
+            half,
+            position,
+            rotation: glam::Quat::IDENTITY,
+            fixed: false,
+        }
+    }
+
+    /// The ground of every contact scene: top face at y = 0, 100 m × 100 m.
+    #[must_use]
+    pub fn ground() -> Self {
+        Self {
+            half: Vec3::new(50.0, 0.5, 50.0),
+            position: Vec3::new(0.0, -0.5, 0.0),
+            rotation: glam::Quat::IDENTITY,
+            fixed: true,
+        }
+    }
+}
+
+/// Spawns a scene; returns the dynamic boxes in order.
 ///
 /// # Errors
-/// Constructor errors (none with these values).
-pub fn box_stack(world: &mut World, n: usize) -> Result<Vec<Entity>> {
-    ground(world)?;
-    let mut out = Vec::with_capacity(n * n * n);
+/// Constructor errors for bad sizes.
+pub fn spawn_boxes(world: &mut World, specs: &[BoxSpec]) -> Result<Vec<Entity>> {
+    let mut out = Vec::new();
+    for b in specs {
+        let collider = crate::Collider::cuboid(b.half.x, b.half.y, b.half.z)?;
+        if b.fixed {
+            world.spawn((
+                crate::RigidBodyBundle::fixed(b.position, b.rotation)?,
+                collider,
+            ));
+        } else {
+            let props = crate::MassProperties::from_shape(&**collider.shape(), 1000.0)?;
+            let body = crate::RigidBodyBundle::dynamic(props)?
+                .at(b.position)?
+                .with_rotation(b.rotation)?;
+            out.push(world.spawn((body, collider)).id());
+        }
+    }
+    Ok(out)
+}
+
+/// Rapier's "boxes" scene: the ground and `n` × `n` columns of `n` unit boxes, columns
+/// 1.5 m apart, bottom layer first.
+#[must_use]
+pub fn box_stack_spec(n: usize) -> Vec<BoxSpec> {
+    let mut out = vec![BoxSpec::ground()];
     let offset = (n as f32 - 1.0) * 0.75;
     for layer in 0..n {
         for i in 0..n {
@@ -220,70 +277,58 @@ pub fn box_stack(world: &mut World, n: usize) -> Result<Vec<Entity>> {
                     0.5 + layer as f32,
                     k as f32 * 1.5 - offset,
                 );
-                out.push(dynamic_box(world, Vec3::splat(0.5), x)?);
+                out.push(BoxSpec::dynamic(Vec3::splat(0.5), x));
             }
         }
     }
-    Ok(out)
+    out
 }
 
-/// A pyramid of `layers` rows of unit boxes in one plane (layers·(layers+1)/2 boxes).
-///
-/// # Errors
-/// Constructor errors (none with these values).
-pub fn pyramid(world: &mut World, layers: usize) -> Result<Vec<Entity>> {
-    ground(world)?;
-    let mut out = Vec::new();
+/// A pyramid of `layers` rows of unit boxes in one plane, on the ground.
+#[must_use]
+pub fn pyramid_spec(layers: usize) -> Vec<BoxSpec> {
+    let mut out = vec![BoxSpec::ground()];
     for row in 0..layers {
         let count = layers - row;
         for i in 0..count {
             let x = (i as f32 - (count as f32 - 1.0) / 2.0) * 1.05;
-            out.push(dynamic_box(
-                world,
+            out.push(BoxSpec::dynamic(
                 Vec3::splat(0.5),
                 Vec3::new(x, 0.5 + row as f32, 0.0),
-            )?);
+            ));
         }
     }
-    Ok(out)
+    out
 }
 
-/// `n` unit boxes falling from a lattice 2 m apart (lowest 2 m above the ground), slightly
-/// turned so they tumble.
-///
-/// # Errors
-/// Constructor errors (none with these values).
-pub fn falling_boxes(world: &mut World, n: usize) -> Result<Vec<Entity>> {
-    ground(world)?;
+/// `n` unit boxes in one layer 2.5 m up, 1.5 m apart, slightly turned, above the ground.
+/// (Turned by up to 0.3 rad a unit box reaches 0.62 m from its centre, so 1.5 m keeps them
+/// apart until they land.)
+#[must_use]
+pub fn falling_boxes_spec(n: usize) -> Vec<BoxSpec> {
     let side = (n as f32).sqrt().ceil() as usize;
-    let mut out = Vec::with_capacity(n);
+    let mut out = vec![BoxSpec::ground()];
     for i in 0..n {
         let (a, b) = (i % side, i / side);
-        let layer = i / (side * side);
         let x = Vec3::new(
-            (a as f32 - side as f32 / 2.0) * 1.2,
-            2.5 + layer as f32 * 1.2,
-            ((b % side) as f32 - side as f32 / 2.0) * 1.2,
+            (a as f32 - side as f32 / 2.0) * 1.5,
+            2.5,
+            (b as f32 - side as f32 / 2.0) * 1.5,
         );
-        let e = dynamic_box(world, Vec3::splat(0.5), x)?;
-        let q = glam::Quat::from_scaled_axis(jitter(i) * 0.3);
-        if let Some(mut r) = world.get_mut::<crate::Rotation>(e) {
-            r.0 = q;
-        }
-        out.push(e);
+        out.push(BoxSpec {
+            rotation: glam::Quat::from_scaled_axis(jitter(i) * 0.3),
+            ..BoxSpec::dynamic(Vec3::splat(0.5), x)
+        });
     }
-    Ok(out)
+    out
 }
 
 /// A heap: `n` unit boxes in columns 1.1 m apart and layers 1.3 m apart (about ∛n of each),
 /// each turned by up to 0.3 rad, dropped onto the ground and onto each other.
-///
-/// # Errors
-/// Constructor errors (none with these values).
-pub fn box_pile(world: &mut World, n: usize) -> Result<Vec<Entity>> {
-    ground(world)?;
+#[must_use]
+pub fn box_pile_spec(n: usize) -> Vec<BoxSpec> {
     let side = (n as f32).cbrt().ceil() as usize;
-    let mut out = Vec::with_capacity(n);
+    let mut out = vec![BoxSpec::ground()];
     for i in 0..n {
         let (a, b, layer) = (i % side, (i / side) % side, i / (side * side));
         let half = side as f32 / 2.0;
@@ -292,11 +337,42 @@ pub fn box_pile(world: &mut World, n: usize) -> Result<Vec<Entity>> {
             1.0 + layer as f32 * 1.3,
             (b as f32 - half) * 1.1,
         );
-        let e = dynamic_box(world, Vec3::splat(0.5), x)?;
-        if let Some(mut r) = world.get_mut::<crate::Rotation>(e) {
-            r.0 = glam::Quat::from_scaled_axis(jitter(i) * 0.3);
-        }
-        out.push(e);
+        out.push(BoxSpec {
+            rotation: glam::Quat::from_scaled_axis(jitter(i) * 0.3),
+            ..BoxSpec::dynamic(Vec3::splat(0.5), x)
+        });
     }
-    Ok(out)
+    out
+}
+
+/// [`box_stack_spec`], spawned.
+///
+/// # Errors
+/// As [`spawn_boxes`].
+pub fn box_stack(world: &mut World, n: usize) -> Result<Vec<Entity>> {
+    spawn_boxes(world, &box_stack_spec(n))
+}
+
+/// [`pyramid_spec`], spawned.
+///
+/// # Errors
+/// As [`spawn_boxes`].
+pub fn pyramid(world: &mut World, layers: usize) -> Result<Vec<Entity>> {
+    spawn_boxes(world, &pyramid_spec(layers))
+}
+
+/// [`falling_boxes_spec`], spawned.
+///
+/// # Errors
+/// As [`spawn_boxes`].
+pub fn falling_boxes(world: &mut World, n: usize) -> Result<Vec<Entity>> {
+    spawn_boxes(world, &falling_boxes_spec(n))
+}
+
+/// [`box_pile_spec`], spawned.
+///
+/// # Errors
+/// As [`spawn_boxes`].
+pub fn box_pile(world: &mut World, n: usize) -> Result<Vec<Entity>> {
+    spawn_boxes(world, &box_pile_spec(n))
 }

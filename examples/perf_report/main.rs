@@ -8,6 +8,7 @@
 //! cargo run --release --example perf_report -- --quick
 //! ```
 
+mod contacts;
 mod rigid;
 #[path = "../common/timing.rs"]
 mod timing;
@@ -379,6 +380,7 @@ fn main() {
     all_plugins_vs_needed(&cfg, 100_000);
     rigid::rigid_free(&cfg, 1_000);
     rigid::rigid_free(&cfg, 100_000);
+    contacts::contact_scenes(&cfg, quick);
 
     accuracy_dial(&cfg);
     println!("\n# total {:.1} s", start.elapsed().as_secs_f64());

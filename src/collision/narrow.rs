@@ -138,6 +138,25 @@ impl Contacts {
         Some(p)
     }
 
+    /// Pairs whose boxes overlap (touching or not).
+    #[must_use]
+    pub fn pairs_len(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Manifolds and contact points (touching or speculative) over all pairs.
+    #[must_use]
+    pub fn manifold_stats(&self) -> (usize, usize) {
+        let m = self.pairs.values().map(|s| s.manifolds.len()).sum();
+        let p = self
+            .pairs
+            .values()
+            .flat_map(|s| &s.manifolds)
+            .map(|m| m.points.len())
+            .sum();
+        (m, p)
+    }
+
     /// Number of touching pairs.
     #[must_use]
     pub fn touching_count(&self) -> usize {

@@ -8,7 +8,7 @@ use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 use super::broad::{BroadPhase, Entry};
 use super::narrow::{ContactImpulse, Contacts, PairState};
 use super::solver::{
-    ContactSolver, FIXED, ManifoldConstraint, PointConstraint, Softness, SolverBody, effective_mass,
+    Axis, ContactSolver, FIXED, ManifoldConstraint, PointConstraint, Softness, SolverBody,
 };
 use super::{
     Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted,
@@ -283,7 +283,7 @@ fn body_index(solver: &mut ContactSolver, e: Entity, b: &PreparedBody) -> u32 {
         x0: x.0,
         q0: q.0,
         dx: Vec3A::ZERO,
-        dq: Quat::IDENTITY,
+        dr: Mat3::IDENTITY,
         v: v.0,
         w: w.map_or(Vec3A::ZERO, |w| w.0),
         ang: Vec3A::ZERO,
@@ -382,10 +382,10 @@ fn prepare_contacts(
                     r_a,
                     r_b,
                     base: p.dist - n.dot(r_b - r_a),
-                    n_mass: effective_mass(ma, &iia, r_a, mb, &iib, r_b, n),
-                    t_mass: [
-                        effective_mass(ma, &iia, r_a, mb, &iib, r_b, t[0]),
-                        effective_mass(ma, &iia, r_a, mb, &iib, r_b, t[1]),
+                    normal: Axis::new(ma, &iia, r_a, mb, &iib, r_b, n),
+                    tangent: [
+                        Axis::new(ma, &iia, r_a, mb, &iib, r_b, t[0]),
+                        Axis::new(ma, &iia, r_a, mb, &iib, r_b, t[1]),
                     ],
                     n_imp: p.data.normal,
                     t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
@@ -427,7 +427,7 @@ fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
             continue;
         };
         b.dx = x.0 - b.x0;
-        b.dq = q.0 * b.q0.inverse();
+        b.dr = Mat3::from_quat(q.0 * b.q0.inverse());
         b.v = v.0;
         b.w = match (inertia, l) {
             (Some(i), Some(l)) if !i.is_infinite() => i.angular_velocity(q.0, l.0),

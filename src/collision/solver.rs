@@ -31,9 +31,9 @@ pub(crate) struct SolverBody {
     /// Centre of mass and rotation at the start of the step.
     pub x0: Vec3A,
     pub q0: Quat,
-    /// Displacement and rotation since the start of the step.
+    /// Displacement and rotation (as a matrix) since the start of the step.
     pub dx: Vec3A,
-    pub dq: Quat,
+    pub dr: Mat3,
     pub v: Vec3A,
     pub w: Vec3A,
     /// Σ r × P applied during the current pass: added to L on scatter.
@@ -42,15 +42,42 @@ pub(crate) struct SolverBody {
     pub dynamic: bool,
 }
 
+/// One direction (normal or tangent) of a contact point, with everything the solver needs
+/// precomputed: the lever products r × d and their images I⁻¹(r × d), and the effective mass.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Axis {
+    pub rd_a: Vec3A,
+    pub rd_b: Vec3A,
+    pub ird_a: Vec3A,
+    pub ird_b: Vec3A,
+    pub mass: f32,
+}
+
+impl Axis {
+    pub fn new(ma: f32, ia: &Mat3, ra: Vec3A, mb: f32, ib: &Mat3, rb: Vec3A, d: Vec3A) -> Self {
+        let (rd_a, rd_b) = (ra.cross(d), rb.cross(d));
+        let ird_a = Vec3A::from(*ia * glam::Vec3::from(rd_a));
+        let ird_b = Vec3A::from(*ib * glam::Vec3::from(rd_b));
+        let k = ma + mb + rd_a.dot(ird_a) + rd_b.dot(ird_b);
+        Self {
+            rd_a,
+            rd_b,
+            ird_a,
+            ird_b,
+            mass: if k > 0.0 { 1.0 / k } else { 0.0 },
+        }
+    }
+}
+
 #[derive(Debug, Clone, Copy, Default)]
 pub(crate) struct PointConstraint {
     pub r_a: Vec3A,
     pub r_b: Vec3A,
     /// Separation minus n·(r_b − r_a) at the start: the current separation is
-    /// n·(Δx_b + R_b r_b − Δx_a − R_a r_a) + base.
+    /// n·(Δx_b + ΔR_b r_b − Δx_a − ΔR_a r_a) + base.
     pub base: f32,
-    pub n_mass: f32,
-    pub t_mass: [f32; 2],
+    pub normal: Axis,
+    pub tangent: [Axis; 2],
     pub n_imp: f32,
     pub t_imp: [f32; 2],
     pub max_n: f32,
@@ -113,56 +140,72 @@ impl Softness {
     }
 }
 
-/// 1 / (1/m_a + 1/m_b + d·(I_a⁻¹(r_a×d))×r_a + d·(I_b⁻¹(r_b×d))×r_b), or 0 when nothing can move.
-pub(crate) fn effective_mass(
-    ma: f32,
-    ia: &Mat3,
-    ra: Vec3A,
-    mb: f32,
-    ib: &Mat3,
-    rb: Vec3A,
-    d: Vec3A,
-) -> f32 {
-    let ca = Vec3A::from(*ia * glam::Vec3::from(ra.cross(d))).cross(ra);
-    let cb = Vec3A::from(*ib * glam::Vec3::from(rb.cross(d))).cross(rb);
-    let k = ma + mb + d.dot(ca + cb);
-    if k > 0.0 { 1.0 / k } else { 0.0 }
-}
-
+/// The velocity state of one side of a manifold during a pass (a fixed side is all zeros).
+#[derive(Clone, Copy)]
 struct Side {
     v: Vec3A,
     w: Vec3A,
-    inv_m: f32,
-    inv_i: Mat3,
-    dx: Vec3A,
-    dq: Quat,
     ang: Vec3A,
+    inv_m: f32,
+    dx: Vec3A,
+    dr: Mat3,
+}
+
+const FIXED_SIDE: Side = Side {
+    v: Vec3A::ZERO,
+    w: Vec3A::ZERO,
+    ang: Vec3A::ZERO,
+    inv_m: 0.0,
+    dx: Vec3A::ZERO,
+    dr: Mat3::IDENTITY,
+};
+
+impl Side {
+    /// Relative velocity of b against a along `axis` at the point.
+    #[inline]
+    fn along(a: &Side, b: &Side, d: Vec3A, axis: &Axis) -> f32 {
+        d.dot(b.v - a.v) + b.w.dot(axis.rd_b) - a.w.dot(axis.rd_a)
+    }
+
+    /// Applies impulse λ along `d`: −λ to a, +λ to b.
+    #[inline]
+    fn push(a: &mut Side, b: &mut Side, d: Vec3A, axis: &Axis, lambda: f32) {
+        a.v -= (a.inv_m * lambda) * d;
+        a.w -= lambda * axis.ird_a;
+        a.ang -= lambda * axis.rd_a;
+        b.v += (b.inv_m * lambda) * d;
+        b.w += lambda * axis.ird_b;
+        b.ang += lambda * axis.rd_b;
+    }
 }
 
 impl ContactSolver {
+    #[inline]
     fn side(&self, i: u32) -> Side {
         match self.bodies.get(i as usize) {
+            Some(b) if b.dynamic => Side {
+                v: b.v,
+                w: b.w,
+                ang: b.ang,
+                inv_m: b.inv_mass,
+                dx: b.dx,
+                dr: b.dr,
+            },
+            // A kinematic body moves its side of the contact but takes no impulse: its
+            // precomputed inverse-inertia terms are zero and so is its inverse mass here.
             Some(b) => Side {
                 v: b.v,
                 w: b.w,
-                inv_m: if b.dynamic { b.inv_mass } else { 0.0 },
-                inv_i: if b.dynamic { b.inv_i } else { Mat3::ZERO },
-                dx: b.dx,
-                dq: b.dq,
-                ang: b.ang,
-            },
-            None => Side {
-                v: Vec3A::ZERO,
-                w: Vec3A::ZERO,
-                inv_m: 0.0,
-                inv_i: Mat3::ZERO,
-                dx: Vec3A::ZERO,
-                dq: Quat::IDENTITY,
                 ang: Vec3A::ZERO,
+                inv_m: 0.0,
+                dx: b.dx,
+                dr: b.dr,
             },
+            None => FIXED_SIDE,
         }
     }
 
+    #[inline]
     fn store(&mut self, i: u32, s: &Side) {
         if let Some(b) = self.bodies.get_mut(i as usize)
             && b.dynamic
@@ -173,27 +216,15 @@ impl ContactSolver {
         }
     }
 
-    /// Applies impulse `p` at lever arms (r_a, r_b): −p to a, +p to b.
-    #[inline]
-    fn apply(a: &mut Side, b: &mut Side, ra: Vec3A, rb: Vec3A, p: Vec3A) {
-        let la = ra.cross(p);
-        let lb = rb.cross(p);
-        a.v -= a.inv_m * p;
-        a.w -= Vec3A::from(a.inv_i * glam::Vec3::from(la));
-        a.ang -= la;
-        b.v += b.inv_m * p;
-        b.w += Vec3A::from(b.inv_i * glam::Vec3::from(lb));
-        b.ang += lb;
-    }
-
     /// Applies every accumulated impulse once (warm start).
     pub fn warm_start(&mut self) {
         for mi in 0..self.manifolds.len() {
             let m = self.manifolds[mi];
             let (mut a, mut b) = (self.side(m.a), self.side(m.b));
             for p in &self.points[m.first as usize..(m.first + m.count) as usize] {
-                let imp = p.n_imp * m.n + p.t_imp[0] * m.t[0] + p.t_imp[1] * m.t[1];
-                Self::apply(&mut a, &mut b, p.r_a, p.r_b, imp);
+                Side::push(&mut a, &mut b, m.n, &p.normal, p.n_imp);
+                Side::push(&mut a, &mut b, m.t[0], &p.tangent[0], p.t_imp[0]);
+                Side::push(&mut a, &mut b, m.t[1], &p.tangent[1], p.t_imp[1]);
             }
             self.store(m.a, &a);
             self.store(m.b, &b);
@@ -203,8 +234,8 @@ impl ContactSolver {
     /// One pass over every contact: normal impulses (with the soft bias when `use_bias`) and
     /// friction. With the bias, friction goes first: the soft normal solve relaxes the
     /// accumulated normal impulse by S_i, and a friction limit taken from that relaxed value
-    /// lets bodies creep down slopes (measured: 7 % too little friction on a 30° incline). The
-    /// relax pass solves the normal first, so its friction sees the full normal impulse.
+    /// would let bodies creep. The relax pass solves the normal first, so its friction sees
+    /// the full normal impulse.
     pub fn solve(
         &mut self,
         h: f32,
@@ -223,7 +254,8 @@ impl ContactSolver {
                 Self::friction(&m, &mut self.points[range.clone()], &mut a, &mut b);
             }
             for p in &mut self.points[range.clone()] {
-                let d = (b.dx - a.dx) + (b.dq * p.r_b - a.dq * p.r_a);
+                let d = (b.dx - a.dx)
+                    + Vec3A::from(b.dr * glam::Vec3::from(p.r_b) - a.dr * glam::Vec3::from(p.r_a));
                 let s = m.n.dot(d) + p.base;
                 let (bias, mass_scale, impulse_scale) = if s > 0.0 {
                     (s * inv_h, 1.0, 0.0)
@@ -236,8 +268,8 @@ impl ContactSolver {
                 } else {
                     (0.0, 1.0, 0.0)
                 };
-                let vn = m.n.dot((b.v + b.w.cross(p.r_b)) - (a.v + a.w.cross(p.r_a)));
-                let imp = -p.n_mass * mass_scale * (vn + bias) - impulse_scale * p.n_imp;
+                let vn = Side::along(&a, &b, m.n, &p.normal);
+                let imp = -p.normal.mass * mass_scale * (vn + bias) - impulse_scale * p.n_imp;
                 let total = (p.n_imp + imp).max(0.0);
                 let imp = total - p.n_imp;
                 if p.max_n == 0.0 && imp > 0.0 {
@@ -247,7 +279,7 @@ impl ContactSolver {
                 }
                 p.n_imp = total;
                 p.max_n = p.max_n.max(imp);
-                Self::apply(&mut a, &mut b, p.r_a, p.r_b, imp * m.n);
+                Side::push(&mut a, &mut b, m.n, &p.normal, imp);
             }
             if !use_bias {
                 Self::friction(&m, &mut self.points[range], &mut a, &mut b);
@@ -258,6 +290,7 @@ impl ContactSolver {
     }
 
     /// Coulomb friction for one manifold: the tangent impulse vector clamped to μ λ_n.
+    #[inline]
     fn friction(
         m: &ManifoldConstraint,
         points: &mut [PointConstraint],
@@ -265,21 +298,20 @@ impl ContactSolver {
         b: &mut Side,
     ) {
         for p in points {
-            let dv = (b.v + b.w.cross(p.r_b)) - (a.v + a.w.cross(p.r_a));
             let old = p.t_imp;
             let mut new = [
-                old[0] - p.t_mass[0] * m.t[0].dot(dv),
-                old[1] - p.t_mass[1] * m.t[1].dot(dv),
+                old[0] - p.tangent[0].mass * Side::along(a, b, m.t[0], &p.tangent[0]),
+                old[1] - p.tangent[1].mass * Side::along(a, b, m.t[1], &p.tangent[1]),
             ];
             let limit = m.friction * p.n_imp;
-            let len = (new[0] * new[0] + new[1] * new[1]).sqrt();
-            if len > limit && len > 0.0 {
-                let s = limit / len;
+            let len2 = new[0] * new[0] + new[1] * new[1];
+            if len2 > limit * limit && len2 > 0.0 {
+                let s = limit / len2.sqrt();
                 new = [new[0] * s, new[1] * s];
             }
             p.t_imp = new;
-            let imp = (new[0] - old[0]) * m.t[0] + (new[1] - old[1]) * m.t[1];
-            Self::apply(a, b, p.r_a, p.r_b, imp);
+            Side::push(a, b, m.t[0], &p.tangent[0], new[0] - old[0]);
+            Side::push(a, b, m.t[1], &p.tangent[1], new[1] - old[1]);
         }
     }
 
@@ -296,12 +328,12 @@ impl ContactSolver {
                 if p.approach > -threshold || p.max_n == 0.0 {
                     continue;
                 }
-                let vn = m.n.dot((b.v + b.w.cross(p.r_b)) - (a.v + a.w.cross(p.r_a)));
-                let imp = -p.n_mass * (vn + m.restitution * p.approach);
+                let vn = Side::along(&a, &b, m.n, &p.normal);
+                let imp = -p.normal.mass * (vn + m.restitution * p.approach);
                 let total = (p.n_imp + imp).max(0.0);
                 let imp = total - p.n_imp;
                 p.n_imp = total;
-                Self::apply(&mut a, &mut b, p.r_a, p.r_b, imp * m.n);
+                Side::push(&mut a, &mut b, m.n, &p.normal, imp);
             }
             self.store(m.a, &a);
             self.store(m.b, &b);
