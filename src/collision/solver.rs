@@ -362,16 +362,16 @@ mod tests {
     fn effective_mass_of_a_point_mass_and_a_lever() {
         let z = Mat3::ZERO;
         assert_eq!(
-            effective_mass(0.5, &z, Vec3A::ZERO, 0.0, &z, Vec3A::ZERO, Vec3A::Y),
+            Axis::new(0.5, &z, Vec3A::ZERO, 0.0, &z, Vec3A::ZERO, Vec3A::Y).mass,
             2.0
         );
         // A unit-inertia body hit at r = x along y: k = 1/m + |r × n|² / I = 1 + 1.
         let i = Mat3::IDENTITY;
         assert!(
-            (effective_mass(1.0, &i, Vec3A::X, 0.0, &z, Vec3A::ZERO, Vec3A::Y) - 0.5).abs() < 1e-6
+            (Axis::new(1.0, &i, Vec3A::X, 0.0, &z, Vec3A::ZERO, Vec3A::Y).mass - 0.5).abs() < 1e-6
         );
         assert_eq!(
-            effective_mass(0.0, &z, Vec3A::X, 0.0, &z, Vec3A::X, Vec3A::Y),
+            Axis::new(0.0, &z, Vec3A::X, 0.0, &z, Vec3A::X, Vec3A::Y).mass,
             0.0
         );
     }
