@@ -306,16 +306,20 @@ fn tangent_basis(
     (xa, va, wa): (Vec3A, Vec3A, Vec3A),
     (xb, vb, wb): (Vec3A, Vec3A, Vec3A),
 ) -> [Vec3A; 2] {
-    let (mut slide, mut impulse) = (Vec3A::ZERO, Vec3A::ZERO);
+    let (mut slide, mut impulse, mut normal) = (Vec3A::ZERO, Vec3A::ZERO, 0.0f32);
     for p in &m.points {
         let mid = 0.5 * (Vec3A::from(*pose_a * p.local_p1) + Vec3A::from(*pose_b * p.local_p2));
         slide += (vb + wb.cross(mid - xb)) - (va + wa.cross(mid - xa));
         impulse += Vec3A::from(p.data.tangent);
+        normal += p.data.normal;
     }
     let along = |v: Vec3A| (v - n * n.dot(v)).try_normalize();
+    // Only a clear signal picks the direction: below it (a body at rest under a small
+    // sideways load) a noisy direction would turn the basis from step to step, and a fixed
+    // basis is steadier.
     let t0 = along(slide)
-        .filter(|_| slide.length() > 1e-3 * m.points.len() as f32)
-        .or_else(|| along(impulse))
+        .filter(|_| slide.length() > 1e-2 * m.points.len() as f32)
+        .or_else(|| along(impulse).filter(|_| impulse.length() > 0.05 * normal))
         .unwrap_or_else(|| Vec3A::from(Vec3::from(n).any_orthonormal_pair().0));
     [t0, n.cross(t0)]
 }
@@ -453,7 +457,9 @@ fn scatter(solver: &ContactSolver, bodies: &mut Query<SolvedBody, Live>) {
 }
 
 fn softness(settings: &ContactSettings, h: f32) -> (Softness, Softness) {
-    let hertz = settings.hertz.min(0.25 / h);
+    // An eighth of the substep rate, not Box2D's quarter: at a quarter (60 Hz with 4 substeps
+    // of 60 Hz) a 20-row pyramid crept 8–16 cm in 10 s; at an eighth it holds (measured).
+    let hertz = settings.hertz.min(0.125 / h);
     (
         Softness::new(hertz, settings.damping_ratio, h),
         Softness::new(2.0 * hertz, settings.damping_ratio, h),
