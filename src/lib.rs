@@ -63,7 +63,7 @@ use bevy_ecs::prelude::*;
 
 pub use collision::{
     Collider, CollisionLayers, CollisionPlugin, CombineRule, ContactEnded, ContactSettings,
-    ContactStarted, Contacts, Friction, Restitution, Sensor,
+    ContactStarted, Contacts, Friction, Restitution, Sensor, SpatialQuery,
 };
 pub use diagnostics::{DiagnosticsSettings, PhysicsDiagnostics};
 pub use error::{Error, Result};

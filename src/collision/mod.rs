@@ -32,10 +32,12 @@
 mod broad;
 mod narrow;
 mod plugin;
+mod query;
 mod solver;
 
 pub use narrow::{ContactPair, Contacts};
 pub use plugin::CollisionPlugin;
+pub use query::{Hit, Projection, QueryFilter, SpatialQuery};
 
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};

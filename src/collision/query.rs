@@ -1,0 +1,299 @@
+//! Spatial queries against the colliders: ray casts, shape casts, point projection and
+//! overlaps, as a `SystemParam`.
+//!
+//! Each query tests the colliders' bounding boxes ([`super::ColliderAabb`], as of the last
+//! step) before the exact parry test, and walks every collider: O(n) per query. Queries
+//! return the nearest hit by distance, ties broken by entity, so results are deterministic.
+
+use bevy_ecs::prelude::*;
+use bevy_ecs::system::SystemParam;
+use glam::{Quat, Vec3};
+use parry3d::math::Pose;
+use parry3d::query::{Ray, ShapeCastOptions};
+
+use super::{Collider, ColliderAabb, CollisionLayers, Sensor};
+use crate::particles::Position;
+use crate::quarantine::Quarantined;
+use crate::rigid::{CenterOfMass, Rotation};
+
+/// Which colliders a query sees.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct QueryFilter {
+    /// Only colliders whose memberships meet this mask.
+    pub mask: u32,
+    /// Whether sensors count.
+    pub include_sensors: bool,
+    /// Colliders to skip (the caster itself, say).
+    pub exclude: Vec<Entity>,
+}
+
+impl Default for QueryFilter {
+    fn default() -> Self {
+        Self {
+            mask: u32::MAX,
+            include_sensors: false,
+            exclude: Vec::new(),
+        }
+    }
+}
+
+impl QueryFilter {
+    /// The default filter, also skipping `entity`.
+    #[must_use]
+    pub fn excluding(entity: Entity) -> Self {
+        Self {
+            exclude: vec![entity],
+            ..Default::default()
+        }
+    }
+}
+
+/// A ray or shape cast hit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// The collider hit.
+    pub entity: Entity,
+    /// Distance along the direction (m; the direction is normalised).
+    pub distance: f32,
+    /// World point of impact (m).
+    pub point: Vec3,
+    /// World surface normal of the hit collider at the point.
+    pub normal: Vec3,
+}
+
+/// The closest collider point to a query point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Projection {
+    /// The collider.
+    pub entity: Entity,
+    /// Closest point on it (m).
+    pub point: Vec3,
+    /// Whether the query point is inside it.
+    pub inside: bool,
+    /// Distance from the query point (m; 0 inside a solid).
+    pub distance: f32,
+}
+
+type QueryCollider<'a> = (
+    Entity,
+    &'a Collider,
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    &'a CollisionLayers,
+    &'a ColliderAabb,
+    Has<Sensor>,
+);
+
+/// Spatial queries over every live collider. Use it as a system parameter, or from a
+/// `World` through `SystemState<SpatialQuery>`.
+#[derive(SystemParam)]
+pub struct SpatialQuery<'w, 's> {
+    colliders: Query<'w, 's, QueryCollider<'static>, Without<Quarantined>>,
+}
+
+fn pose(x: &Position, q: &Rotation, com: Option<&CenterOfMass>) -> Pose {
+    let c = com.map_or(Vec3::ZERO, |c| c.0);
+    Pose::from_parts(Vec3::from(x.0) - q.0 * c, q.0)
+}
+
+/// Slab test of a ray against a box: the entry distance, if it enters within `max`.
+fn ray_aabb(origin: Vec3, inv_dir: Vec3, aabb: &ColliderAabb, max: f32) -> Option<f32> {
+    let t1 = (aabb.min - origin) * inv_dir;
+    let t2 = (aabb.max - origin) * inv_dir;
+    let near = t1.min(t2).max_element().max(0.0);
+    let far = t1.max(t2).min_element().min(max);
+    (near <= far).then_some(near)
+}
+
+fn nearer(best: &mut Option<Hit>, hit: Hit) {
+    let better = match best {
+        None => true,
+        Some(b) => {
+            hit.distance < b.distance || (hit.distance == b.distance && hit.entity < b.entity)
+        }
+    };
+    if better {
+        *best = Some(hit);
+    }
+}
+
+impl SpatialQuery<'_, '_> {
+    fn candidates<'a>(
+        &'a self,
+        filter: &'a QueryFilter,
+    ) -> impl Iterator<Item = bevy_ecs::query::QueryItem<'a, 'a, QueryCollider<'static>>> + 'a {
+        self.colliders.iter().filter(move |c| {
+            c.5.memberships & filter.mask != 0
+                && (filter.include_sensors || !c.7)
+                && !filter.exclude.contains(&c.0)
+        })
+    }
+
+    /// The first collider a ray from `origin` along `direction` hits within `max_distance`
+    /// (m). A ray starting inside a solid collider hits it at distance 0.
+    #[must_use]
+    pub fn cast_ray(
+        &self,
+        origin: Vec3,
+        direction: Vec3,
+        max_distance: f32,
+        filter: &QueryFilter,
+    ) -> Option<Hit> {
+        let dir = direction.try_normalize()?;
+        if !(origin.is_finite() && max_distance >= 0.0) {
+            return None;
+        }
+        let ray = Ray::new(origin, dir);
+        let inv = dir.recip();
+        let mut best = None;
+        for (e, c, x, q, com, _, aabb, _) in self.candidates(filter) {
+            let Some(enter) = ray_aabb(origin, inv, aabb, max_distance) else {
+                continue;
+            };
+            if best.is_some_and(|b: Hit| enter > b.distance) {
+                continue;
+            }
+            if let Some(i) =
+                c.shape()
+                    .cast_ray_and_get_normal(&pose(x, q, com), &ray, max_distance, true)
+            {
+                nearer(
+                    &mut best,
+                    Hit {
+                        entity: e,
+                        distance: i.time_of_impact,
+                        point: origin + dir * i.time_of_impact,
+                        normal: i.normal,
+                    },
+                );
+            }
+        }
+        best
+    }
+
+    /// The first collider that `shape`, placed at (`position`, `rotation`) and swept along
+    /// `direction`, touches within `max_distance` (m).
+    #[must_use]
+    pub fn cast_shape(
+        &self,
+        shape: &Collider,
+        position: Vec3,
+        rotation: Quat,
+        direction: Vec3,
+        max_distance: f32,
+        filter: &QueryFilter,
+    ) -> Option<Hit> {
+        let dir = direction.try_normalize()?;
+        let start = Pose::from_parts(position, rotation.normalize());
+        let swept = shape.shape().compute_swept_aabb(
+            &start,
+            &Pose::from_parts(position + dir * max_distance, rotation.normalize()),
+        );
+        let options = ShapeCastOptions::with_max_time_of_impact(max_distance);
+        let mut best = None;
+        for (e, c, x, q, com, _, aabb, _) in self.candidates(filter) {
+            if swept.maxs.cmplt(aabb.min).any() || swept.mins.cmpgt(aabb.max).any() {
+                continue;
+            }
+            let target = pose(x, q, com);
+            let hit = parry3d::query::cast_shapes(
+                &start,
+                dir,
+                &**shape.shape(),
+                &target,
+                Vec3::ZERO,
+                &**c.shape(),
+                options,
+            );
+            if let Ok(Some(h)) = hit {
+                nearer(
+                    &mut best,
+                    Hit {
+                        entity: e,
+                        distance: h.time_of_impact,
+                        point: target * h.witness2,
+                        normal: target.rotation * h.normal2,
+                    },
+                );
+            }
+        }
+        best
+    }
+
+    /// The collider nearest to `point` and its closest point, searching within
+    /// `max_distance` (m).
+    #[must_use]
+    pub fn project_point(
+        &self,
+        point: Vec3,
+        max_distance: f32,
+        filter: &QueryFilter,
+    ) -> Option<Projection> {
+        let mut best: Option<Projection> = None;
+        for (e, c, x, q, com, _, aabb, _) in self.candidates(filter) {
+            let gap = (aabb.min - point)
+                .max(point - aabb.max)
+                .max(Vec3::ZERO)
+                .length();
+            if gap > max_distance || best.is_some_and(|b| gap > b.distance) {
+                continue;
+            }
+            let p = parry3d::query::PointQuery::project_point(
+                &**c.shape(),
+                &pose(x, q, com),
+                point,
+                true,
+            );
+            let distance = if p.is_inside {
+                0.0
+            } else {
+                (p.point - point).length()
+            };
+            if distance <= max_distance
+                && best.is_none_or(|b| {
+                    distance < b.distance || (distance == b.distance && e < b.entity)
+                })
+            {
+                best = Some(Projection {
+                    entity: e,
+                    point: p.point,
+                    inside: p.is_inside,
+                    distance,
+                });
+            }
+        }
+        best
+    }
+
+    /// Every collider that overlaps `shape` at (`position`, `rotation`), sorted.
+    #[must_use]
+    pub fn overlaps(
+        &self,
+        shape: &Collider,
+        position: Vec3,
+        rotation: Quat,
+        filter: &QueryFilter,
+    ) -> Vec<Entity> {
+        let at = Pose::from_parts(position, rotation.normalize());
+        let bounds = shape.shape().compute_aabb(&at);
+        let mut out: Vec<Entity> = self
+            .candidates(filter)
+            .filter(|(_, _, _, _, _, _, aabb, _)| {
+                !(bounds.maxs.cmplt(aabb.min).any() || bounds.mins.cmpgt(aabb.max).any())
+            })
+            .filter(|(_, c, x, q, com, ..)| {
+                parry3d::query::intersection_test(
+                    &at,
+                    &**shape.shape(),
+                    &pose(x, q, *com),
+                    &**c.shape(),
+                )
+                .is_ok_and(|i| i.intersecting)
+            })
+            .map(|c| c.0)
+            .collect();
+        out.sort_unstable();
+        out
+    }
+}

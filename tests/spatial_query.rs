@@ -1,0 +1,148 @@
+//! Spatial queries against exact geometry.
+
+use bevy_ecs::prelude::*;
+use bevy_ecs::system::SystemState;
+use glam::{Quat, Vec3};
+use hooke::collision::{QueryFilter, SpatialQuery};
+use hooke::prelude::*;
+use hooke::{Collider, Sensor, scenes};
+
+fn scene() -> (World, Entity, Entity) {
+    let mut w = scenes::world_with(1.0 / 60.0, 4, Integrator::SymplecticEuler, Vec3::ZERO).unwrap();
+    let ground = scenes::ground(&mut w).unwrap();
+    // A box whose top face is at y = 1.5, centred at (2, 1, 0).
+    let b = scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::new(2.0, 1.0, 0.0)).unwrap();
+    w.step_physics(); // bounding boxes are computed by the step
+    (w, ground, b)
+}
+
+#[test]
+fn ray_cast_hits_the_nearest_surface_with_its_normal() {
+    let (mut w, ground, b) = scene();
+    let mut state = SystemState::<SpatialQuery>::new(&mut w);
+    let q = state.get(&w).unwrap();
+    let hit = q
+        .cast_ray(
+            Vec3::new(2.0, 5.0, 0.0),
+            Vec3::NEG_Y,
+            100.0,
+            &QueryFilter::default(),
+        )
+        .unwrap();
+    assert_eq!(hit.entity, b);
+    assert!((hit.distance - 3.5).abs() < 1e-4, "{}", hit.distance);
+    assert!((hit.normal - Vec3::Y).length() < 1e-4);
+    assert!((hit.point - Vec3::new(2.0, 1.5, 0.0)).length() < 1e-4);
+    // Excluding the box, the ray reaches the ground at y = 0.
+    let hit = q
+        .cast_ray(
+            Vec3::new(2.0, 5.0, 0.0),
+            Vec3::NEG_Y,
+            100.0,
+            &QueryFilter::excluding(b),
+        )
+        .unwrap();
+    assert_eq!(hit.entity, ground);
+    assert!((hit.distance - 5.0).abs() < 1e-4);
+    // Too short, or pointing away: nothing.
+    assert!(
+        q.cast_ray(
+            Vec3::new(2.0, 5.0, 0.0),
+            Vec3::NEG_Y,
+            3.0,
+            &QueryFilter::default()
+        )
+        .is_none()
+    );
+    assert!(
+        q.cast_ray(
+            Vec3::new(2.0, 5.0, 0.0),
+            Vec3::Y,
+            100.0,
+            &QueryFilter::default()
+        )
+        .is_none()
+    );
+    assert!(
+        q.cast_ray(Vec3::ZERO, Vec3::ZERO, 1.0, &QueryFilter::default())
+            .is_none(),
+        "zero direction"
+    );
+}
+
+#[test]
+fn shape_cast_stops_a_ball_at_contact_distance() {
+    let (mut w, _, b) = scene();
+    let mut state = SystemState::<SpatialQuery>::new(&mut w);
+    let q = state.get(&w).unwrap();
+    let ball = Collider::ball(0.25).unwrap();
+    let hit = q
+        .cast_shape(
+            &ball,
+            Vec3::new(2.0, 4.0, 0.0),
+            Quat::IDENTITY,
+            Vec3::NEG_Y,
+            10.0,
+            &QueryFilter::default(),
+        )
+        .unwrap();
+    // The ball's bottom (y = 3.75) meets the box top (y = 1.5) after 2.25 m.
+    assert_eq!(hit.entity, b);
+    assert!((hit.distance - 2.25).abs() < 1e-3, "{}", hit.distance);
+    assert!((hit.normal - Vec3::Y).length() < 1e-3, "{}", hit.normal);
+}
+
+#[test]
+fn point_projection_and_overlaps() {
+    let (mut w, ground, b) = scene();
+    let sensor = w
+        .spawn((
+            hooke::RigidBodyBundle::fixed(Vec3::new(-3.0, 1.0, 0.0), Quat::IDENTITY).unwrap(),
+            Collider::ball(0.5).unwrap(),
+            Sensor,
+        ))
+        .id();
+    w.step_physics();
+    let mut state = SystemState::<SpatialQuery>::new(&mut w);
+    let q = state.get(&w).unwrap();
+    let p = q
+        .project_point(Vec3::new(2.0, 3.0, 0.0), 10.0, &QueryFilter::default())
+        .unwrap();
+    assert_eq!(p.entity, b);
+    assert!((p.distance - 1.5).abs() < 1e-4 && !p.inside);
+    let inside = q
+        .project_point(Vec3::new(2.0, 1.0, 0.0), 10.0, &QueryFilter::default())
+        .unwrap();
+    assert!(inside.inside && inside.entity == b && inside.distance == 0.0);
+    assert!(
+        q.project_point(Vec3::new(2.0, 30.0, 0.0), 1.0, &QueryFilter::default())
+            .is_none()
+    );
+    // A probe box straddling the box and the ground; the sensor only when asked for.
+    let probe = Collider::cuboid(3.0, 0.3, 0.3).unwrap();
+    let found = q.overlaps(
+        &probe,
+        Vec3::new(0.0, 0.6, 0.0),
+        Quat::IDENTITY,
+        &QueryFilter::default(),
+    );
+    let mut expected = vec![b];
+    expected.sort_unstable();
+    assert_eq!(found, expected);
+    let all = QueryFilter {
+        include_sensors: true,
+        ..Default::default()
+    };
+    let found = q.overlaps(&probe, Vec3::new(0.0, 0.6, 0.0), Quat::IDENTITY, &all);
+    let mut expected = vec![b, sensor];
+    expected.sort_unstable();
+    assert_eq!(found, expected);
+    let low = q.overlaps(
+        &probe,
+        Vec3::new(0.0, 0.0, 0.0),
+        Quat::IDENTITY,
+        &QueryFilter::default(),
+    );
+    // Spanning y ∈ [−0.3, 0.3]: the ground (top at 0), not the box (bottom at 0.5).
+    assert_eq!(low, vec![ground]);
+}
