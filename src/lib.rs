@@ -55,6 +55,7 @@ pub mod quarantine;
 pub mod rigid;
 pub mod scenes;
 pub mod schedule;
+pub mod sleep;
 pub mod springs;
 pub mod time;
 
@@ -83,6 +84,7 @@ pub use rigid::{
 pub use schedule::{
     ForceSchedule, ForceSystems, PhysicsSchedule, PhysicsSystems, StepSystems, SubstepSchedule,
 };
+pub use sleep::{SleepPlugin, SleepSettings, Sleeping, SleepingDisabled};
 pub use springs::{Chain, ChainBuilder, ClothBuilder, Spring, SpringNetwork, SpringPlugin};
 pub use time::{FrameReport, PhysicsTime, SubstepTime};
 
@@ -144,7 +146,8 @@ impl Plugin for PhysicsPlugins {
             .add_physics(VelocityFieldPlugin)
             .add_physics(SpringPlugin)
             .add_physics(RigidBodyPlugin)
-            .add_physics(CollisionPlugin);
+            .add_physics(CollisionPlugin)
+            .add_physics(SleepPlugin);
     }
 }
 

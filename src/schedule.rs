@@ -124,6 +124,8 @@ pub enum IntegrationSystems {
 pub enum PrepareSystems {
     /// Inputs and bookkeeping.
     Inputs,
+    /// Islands fall asleep or wake.
+    Sleep,
     /// Bounding boxes, broad phase, narrow phase, contact constraints.
     Collision,
 }
@@ -158,7 +160,11 @@ pub(crate) fn init_schedules(world: &mut World) {
             .chain(),
     );
     physics.configure_sets(
-        (PrepareSystems::Inputs, PrepareSystems::Collision)
+        (
+            PrepareSystems::Inputs,
+            PrepareSystems::Sleep,
+            PrepareSystems::Collision,
+        )
             .chain()
             .in_set(PhysicsSystems::Prepare),
     );

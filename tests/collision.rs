@@ -11,14 +11,18 @@ use hooke::{
 
 const G: f32 = 9.81;
 
+/// Sleeping off: a sleeping body cannot drift, so with it on a stability test could pass
+/// without measuring anything.
 fn world(substeps: u32) -> World {
-    scenes::world_with(
+    let mut w = scenes::world_with(
         1.0 / 60.0,
         substeps,
         Integrator::SymplecticEuler,
         Vec3::new(0.0, -G, 0.0),
     )
-    .unwrap()
+    .unwrap();
+    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w
 }
 
 fn pos(w: &World, e: Entity) -> Vec3 {

@@ -21,6 +21,7 @@ fn ours(specs: &[BoxSpec]) -> (World, Vec<Entity>) {
     )
     .unwrap();
     world.resource_mut::<DiagnosticsSettings>().energy = false;
+    world.resource_mut::<hooke::SleepSettings>().enabled = false;
     let boxes = scenes::spawn_boxes(&mut world, specs).unwrap();
     (world, boxes)
 }

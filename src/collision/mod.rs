@@ -58,7 +58,8 @@ use crate::rigid::Rotation;
     Friction,
     Restitution,
     CollisionLayers,
-    ColliderAabb
+    ColliderAabb,
+    crate::sleep::SleepTimer
 )]
 pub struct Collider {
     shape: SharedShape,

@@ -20,6 +20,7 @@ use crate::particles::{LinearVelocity, Mass, Position};
 use crate::quarantine::Quarantined;
 use crate::rigid::{AngularMomentum, AngularVelocity, CenterOfMass, Inertia, Rotation};
 use crate::schedule::{PhysicsSchedule, PrepareSystems, StepSystems, SubstepSchedule, add_systems};
+use crate::sleep::Sleeping;
 use crate::time::{PhysicsTime, SubstepTime};
 
 type Live = Without<Quarantined>;
@@ -97,7 +98,7 @@ type MovingCollider<'a> = (
 fn update_moving_aabbs(
     time: Res<PhysicsTime>,
     settings: Res<ContactSettings>,
-    mut colliders: Query<MovingCollider, Live>,
+    mut colliders: Query<MovingCollider, (Live, Without<Sleeping>)>,
 ) {
     let dt = time.dt();
     for (c, x, q, com, v, w, mut aabb) in &mut colliders {
@@ -145,6 +146,7 @@ type BroadCollider<'a> = (
     &'a ColliderAabb,
     &'a CollisionLayers,
     Has<LinearVelocity>,
+    Has<Sleeping>,
 );
 
 fn run_broad_phase(
@@ -152,7 +154,8 @@ fn run_broad_phase(
     colliders: Query<BroadCollider, (With<Collider>, Live)>,
 ) {
     bp.entries.clear();
-    for (entity, aabb, layers, moving) in &colliders {
+    for (entity, aabb, layers, has_velocity, sleeping) in &colliders {
+        let moving = has_velocity && !sleeping;
         bp.entries.push(Entry {
             entity,
             min: aabb.min,
@@ -175,6 +178,7 @@ type NarrowCollider<'a> = (
 );
 
 /// Persistent manifolds for every candidate pair; start/end messages.
+#[allow(clippy::too_many_arguments)] // two message writers and the queries of one pass
 fn update_contacts(
     mut contacts: ResMut<Contacts>,
     bp: Res<BroadPhase>,
@@ -183,6 +187,7 @@ fn update_contacts(
     colliders: Query<NarrowCollider, Live>,
     mut started: MessageWriter<ContactStarted>,
     mut ended: MessageWriter<ContactEnded>,
+    sleeping: Query<(), With<Sleeping>>,
 ) {
     let dt = time.dt();
     contacts.step += 1;
@@ -239,7 +244,9 @@ fn update_contacts(
     let mut gone: Vec<_> = contacts
         .pairs
         .iter()
-        .filter(|(_, s)| s.seen != step)
+        // A pair with a sleeping side is not re-formed while it sleeps, but it still
+        // touches: keep it (and its warm-start impulses) until the island wakes.
+        .filter(|((a, b), s)| s.seen != step && !(sleeping.contains(*a) || sleeping.contains(*b)))
         .map(|(k, s)| (*k, s.touching))
         .collect();
     gone.sort_unstable_by_key(|g| g.0);
@@ -261,16 +268,22 @@ type PreparedBody<'a> = (
     Option<&'a AngularVelocity>,
     &'a Friction,
     &'a Restitution,
+    Has<Sleeping>,
 );
 
 /// Solver index of a collider's body: a new [`SolverBody`] for anything with a velocity,
 /// [`FIXED`] for static colliders.
-fn body_index(solver: &mut ContactSolver, e: Entity, b: &PreparedBody) -> u32 {
+fn body_index(
+    solver: &mut ContactSolver,
+    e: Entity,
+    b: &bevy_ecs::query::QueryItem<'_, '_, PreparedBody<'_>>,
+) -> u32 {
     if let Some(&i) = solver.index.get(&e) {
         return i;
     }
-    let (x, q, _, mass, v, inertia, w, ..) = *b;
-    let (Some(mass), Some(v)) = (mass, v) else {
+    let (x, q, _, mass, v, inertia, w, _, _, sleeping) = *b;
+    // A sleeping body holds still like a static one until its island wakes.
+    let (Some(mass), Some(v), false) = (mass, v, sleeping) else {
         return FIXED;
     };
     let inv_i = inertia.map_or(Mat3::ZERO, |i| i.world_inverse_tensor(q.0));

@@ -60,7 +60,8 @@ impl Plugin for IntegratorPlugin {
     }
 }
 
-type Live = Without<Quarantined>;
+/// Bodies the step moves: not quarantined, not asleep.
+type Live = (Without<Quarantined>, Without<crate::sleep::Sleeping>);
 
 /// Initialises every accumulator with the body's constant forces, f ← f_ext + m g s, and
 /// every torque accumulator with its constant torque, τ ← τ_ext.

@@ -20,7 +20,8 @@ use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, Rotation, Torque, 
 use crate::schedule::ForceSchedule;
 use crate::time::SubstepTime;
 
-type Live = Without<Quarantined>;
+/// Bodies the step moves: not quarantined, not asleep.
+type Live = (Without<Quarantined>, Without<crate::sleep::Sleeping>);
 
 const WEIGHT: [f32; 4] = [1.0, 2.0, 2.0, 1.0];
 const OFFSET: [f32; 3] = [0.5, 0.5, 1.0];

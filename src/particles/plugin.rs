@@ -11,7 +11,8 @@ use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::schedule::{ForceSystems, StepSystems, SubstepSchedule, add_force_systems, add_systems};
 use crate::time::SubstepTime;
 
-type Live = Without<Quarantined>;
+/// Bodies the step moves: not quarantined, not asleep.
+type Live = (Without<Quarantined>, Without<crate::sleep::Sleeping>);
 
 /// Uniform gravity, f = m g s: installs the [`Gravity`] resource. Gravity is a constant
 /// force, so the core's force-clearing pass writes it into each accumulator (see

@@ -18,7 +18,8 @@ use crate::schedule::{
 };
 use crate::time::{PhysicsTime, SubstepTime};
 
-type Live = Without<Quarantined>;
+/// Bodies the step moves: not quarantined, not asleep.
+type Live = (Without<Quarantined>, Without<crate::sleep::Sleeping>);
 
 /// Rotation, angular momentum, torque and renormalisation for bodies with [`Inertia`]. Every
 /// system runs only while such a body exists (or, for the optional inputs, while one has

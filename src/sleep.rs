@@ -1,0 +1,213 @@
+//! Sleeping: bodies at rest stop being simulated until something disturbs them.
+//!
+//! Every step, dynamic bodies with a [`Collider`] are grouped into islands by the contacts
+//! that touch (union–find over [`Contacts`]). A body's [`SleepTimer`] counts how long its
+//! speed has stayed below [`SleepSettings::linear`] and [`SleepSettings::angular`]; when every
+//! body of an island has been still for [`SleepSettings::time`], the whole island gets
+//! [`Sleeping`], its velocities are zeroed, and no integrating system visits it again (an
+//! archetype filter: a sleeping body costs nothing per substep). Sleeping bodies stay solid:
+//! awake bodies collide with them as with static ones.
+//!
+//! **Waking.** An island with a sleeping and a moving member wakes whole (so a body that
+//! lands on a sleeping stack wakes it the next step). Game code wakes a body by writing its
+//! position, rotation or velocity, or by adding an external force, torque or impulse; or by
+//! removing [`Sleeping`] directly.
+//!
+//! Particles, meshes and bodies attached to springs never sleep: springs act only between
+//! awake bodies, and a spring's pull is not a contact that the islands could see.
+
+use std::collections::HashMap;
+
+use bevy_ecs::prelude::*;
+
+use crate::Plugin;
+use crate::collision::{Collider, Contacts};
+use crate::particles::{ExternalForce, ExternalImpulse, LinearVelocity, Mass, Position};
+use crate::quarantine::Quarantined;
+use crate::rigid::{
+    AngularMomentum, AngularVelocity, ExternalForceAtPoint, ExternalImpulseAtPoint, ExternalTorque,
+    Rotation,
+};
+use crate::schedule::{PhysicsSchedule, PrepareSystems, add_systems};
+use crate::springs::Spring;
+use crate::time::PhysicsTime;
+
+/// Marks a body at rest: no system integrates it until it wakes. See the module docs.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Sleeping;
+
+/// Keeps a body from ever sleeping.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SleepingDisabled;
+
+/// How long (s) the body has been slower than the sleep thresholds.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+pub struct SleepTimer(pub f32);
+
+/// When islands fall asleep.
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct SleepSettings {
+    /// Whether bodies may sleep at all.
+    pub enabled: bool,
+    /// Speed below which a body counts as still (m/s).
+    pub linear: f32,
+    /// Spin below which a body counts as still (rad/s).
+    pub angular: f32,
+    /// How long a whole island must stay still before it sleeps (s).
+    pub time: f32,
+}
+
+impl Default for SleepSettings {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            linear: 0.05,
+            angular: 0.05,
+            time: 0.5,
+        }
+    }
+}
+
+/// Island sleeping for bodies with colliders.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct SleepPlugin;
+
+impl Plugin for SleepPlugin {
+    fn build(&self, world: &mut World) {
+        world.init_resource::<SleepSettings>();
+        add_systems(
+            world,
+            PhysicsSchedule,
+            (wake_on_user_change, update_islands)
+                .chain()
+                .run_if(any_with_component::<Collider>)
+                .in_set(PrepareSystems::Sleep),
+        );
+    }
+}
+
+type Disturbed = (
+    With<Sleeping>,
+    Or<(
+        Changed<Position>,
+        Changed<Rotation>,
+        Changed<LinearVelocity>,
+        Changed<AngularVelocity>,
+        Changed<ExternalForce>,
+        Changed<ExternalImpulse>,
+        Changed<ExternalTorque>,
+        Changed<ExternalForceAtPoint>,
+        Changed<ExternalImpulseAtPoint>,
+    )>,
+);
+
+/// Game code touched a sleeping body: wake it. (hooke never writes a sleeping body, so any
+/// change is the game's.)
+fn wake_on_user_change(
+    mut commands: Commands,
+    mut disturbed: Query<(Entity, &mut SleepTimer), Disturbed>,
+) {
+    for (e, mut timer) in &mut disturbed {
+        // A woken body starts its stillness count afresh, or it would fall straight back asleep.
+        timer.0 = 0.0;
+        commands.entity(e).remove::<Sleeping>();
+    }
+}
+
+fn find(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+type SleepBody<'a> = (
+    Entity,
+    &'a Mass,
+    &'a mut LinearVelocity,
+    Option<&'a mut AngularVelocity>,
+    Option<&'a mut AngularMomentum>,
+    &'a mut SleepTimer,
+    Has<Sleeping>,
+    Has<SleepingDisabled>,
+);
+
+/// Timers, islands, and the sleep/wake decisions.
+fn update_islands(
+    mut commands: Commands,
+    settings: Res<SleepSettings>,
+    time: Res<PhysicsTime>,
+    contacts: Res<Contacts>,
+    springs: Query<&Spring>,
+    mut bodies: Query<SleepBody, (With<Collider>, Without<Quarantined>)>,
+) {
+    let dt = time.dt();
+    let mut index = HashMap::new();
+    let mut still = Vec::new();
+    let mut asleep = Vec::new();
+    let mut entities = Vec::new();
+    for (e, m, v, w, _, mut timer, sleeping, disabled) in &mut bodies {
+        if m.is_pinned() {
+            continue;
+        }
+        let slow =
+            v.0.length() < settings.linear && w.is_none_or(|w| w.0.length() < settings.angular);
+        timer.0 = if slow && !disabled && settings.enabled {
+            timer.0 + dt
+        } else {
+            0.0
+        };
+        index.insert(e, entities.len());
+        entities.push(e);
+        still.push(sleeping || timer.0 >= settings.time);
+        asleep.push(sleeping);
+    }
+    if entities.is_empty() {
+        return;
+    }
+    // Spring endpoints never sleep.
+    for s in &springs {
+        for e in [s.a(), s.b()] {
+            if let Some(&i) = index.get(&e) {
+                still[i] = false;
+            }
+        }
+    }
+    let mut parent: Vec<usize> = (0..entities.len()).collect();
+    for (a, b) in contacts.touching() {
+        if let (Some(&i), Some(&j)) = (index.get(&a), index.get(&b)) {
+            let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
+            if ri != rj {
+                parent[ri.max(rj)] = ri.min(rj);
+            }
+        }
+    }
+    let mut island_still = vec![true; entities.len()];
+    for (i, &s) in still.iter().enumerate() {
+        let r = find(&mut parent, i);
+        island_still[r] &= s;
+    }
+    for i in 0..entities.len() {
+        let r = find(&mut parent, i);
+        let e = entities[i];
+        if island_still[r] && !asleep[i] {
+            if let Ok((_, _, mut v, w, l, ..)) = bodies.get_mut(e) {
+                // Without change ticks: a tick here would read as the game waking it.
+                v.bypass_change_detection().0 = glam::Vec3A::ZERO;
+                if let Some(mut w) = w {
+                    w.bypass_change_detection().0 = glam::Vec3A::ZERO;
+                }
+                if let Some(mut l) = l {
+                    l.bypass_change_detection().0 = glam::Vec3A::ZERO;
+                }
+            }
+            commands.entity(e).insert(Sleeping);
+        } else if !island_still[r] && asleep[i] {
+            if let Ok((.., mut timer, _, _)) = bodies.get_mut(e) {
+                timer.0 = 0.0;
+            }
+            commands.entity(e).remove::<Sleeping>();
+        }
+    }
+}
