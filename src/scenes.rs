@@ -376,3 +376,39 @@ pub fn falling_boxes(world: &mut World, n: usize) -> Result<Vec<Entity>> {
 pub fn box_pile(world: &mut World, n: usize) -> Result<Vec<Entity>> {
     spawn_boxes(world, &box_pile_spec(n))
 }
+
+/// The pile example's scene: a ground, a 20° ramp, and `boxes` boxes and `balls` balls
+/// dropped from a lattice above the ramp. Returns (boxes, balls).
+///
+/// # Errors
+/// Constructor errors (none with these values).
+pub fn pile_scene(
+    world: &mut World,
+    boxes: usize,
+    balls: usize,
+) -> Result<(Vec<Entity>, Vec<Entity>)> {
+    ground(world)?;
+    let q = glam::Quat::from_rotation_z(20f32.to_radians());
+    world.spawn((
+        crate::RigidBodyBundle::fixed(Vec3::new(-3.0, 1.5, 0.0), q)?,
+        crate::Collider::cuboid(4.0, 0.2, 2.0)?,
+    ));
+    let mut out = (Vec::new(), Vec::new());
+    for i in 0..boxes + balls {
+        let x = Vec3::new(
+            -5.5 + (i % 8) as f32 * 0.9,
+            5.0 + (i / 8) as f32 * 0.9,
+            -1.0 + (i % 3) as f32 * 0.8,
+        ) + jitter(i) * 0.1;
+        if i % 3 == 2 && out.1.len() < balls || out.0.len() >= boxes {
+            out.1.push(dynamic_ball(world, 0.3, x)?);
+        } else {
+            let e = dynamic_box(world, Vec3::new(0.35, 0.25, 0.3), x)?;
+            if let Some(mut r) = world.get_mut::<crate::Rotation>(e) {
+                r.0 = glam::Quat::from_scaled_axis(jitter(i + 7) * 1.0);
+            }
+            out.0.push(e);
+        }
+    }
+    Ok(out)
+}

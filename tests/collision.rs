@@ -340,3 +340,23 @@ fn pyramid_of_twenty_rows_holds_at_the_default_substeps() {
     );
     assert!(creep < 2e-3, "creep {creep}");
 }
+
+#[test]
+fn the_pile_example_scene_runs_clean_and_comes_to_rest_on_the_ramp_and_ground() {
+    let mut w = scenes::world_with(
+        1.0 / 60.0,
+        4,
+        Integrator::SymplecticEuler,
+        Vec3::new(0.0, -G, 0.0),
+    )
+    .unwrap();
+    let (boxes, balls) = scenes::pile_scene(&mut w, 60, 30).unwrap();
+    for _ in 0..300 {
+        w.step_physics();
+    }
+    assert_eq!(w.resource::<PhysicsDiagnostics>().counts.quarantined, 0);
+    for &e in boxes.iter().chain(&balls) {
+        let p = pos(&w, e);
+        assert!(p.is_finite() && p.y > 0.0, "{e} fell through to {p}");
+    }
+}

@@ -10,7 +10,7 @@ use std::path::Path;
 pub struct Canvas {
     pub width: usize,
     pub height: usize,
-    pixels: Vec<[u8; 3]>,
+    pub pixels: Vec<[u8; 3]>,
     /// World rectangle shown: (x_min, y_min, x_max, y_max).
     view: [f32; 4],
 }
@@ -23,6 +23,11 @@ impl Canvas {
             pixels: vec![background; width * height],
             view,
         }
+    }
+
+    /// Paints every pixel `color`.
+    pub fn clear(&mut self, color: [u8; 3]) {
+        self.pixels.fill(color);
     }
 
     /// World (x, y) to pixel (column, row), y up.
@@ -166,4 +171,87 @@ pub fn ramp(t: f32) -> [u8; 3] {
     let t = t.clamp(0.0, 1.0);
     let lerp = |a: f32, b: f32| (a + (b - a) * t) as u8;
     [lerp(40.0, 240.0), lerp(90.0, 140.0), lerp(220.0, 30.0)]
+}
+
+/// An animated GIF built from RGB canvases, quantised to a 6×6×6 colour cube and stored
+/// with 9-bit literal LZW codes (a clear code every 250 pixels keeps the code width fixed):
+/// larger than a compressing encoder's output, but valid and dependency-free.
+pub struct Gif {
+    width: usize,
+    height: usize,
+    bytes: Vec<u8>,
+}
+
+impl Gif {
+    pub fn new(width: usize, height: usize) -> Self {
+        let mut bytes = b"GIF89a".to_vec();
+        bytes.extend_from_slice(&(width as u16).to_le_bytes());
+        bytes.extend_from_slice(&(height as u16).to_le_bytes());
+        bytes.extend_from_slice(&[0xF7, 0, 0]); // global table of 256 colours
+        for i in 0..256u32 {
+            let (r, g, b) = if i < 216 {
+                (i / 36, (i / 6) % 6, i % 6)
+            } else {
+                (5, 5, 5)
+            };
+            bytes.extend_from_slice(&[(r * 51) as u8, (g * 51) as u8, (b * 51) as u8]);
+        }
+        // Loop forever.
+        bytes.extend_from_slice(&[0x21, 0xFF, 0x0B]);
+        bytes.extend_from_slice(b"NETSCAPE2.0");
+        bytes.extend_from_slice(&[0x03, 0x01, 0x00, 0x00, 0x00]);
+        Self {
+            width,
+            height,
+            bytes,
+        }
+    }
+
+    /// Appends a frame shown for `delay_cs` hundredths of a second.
+    pub fn frame(&mut self, canvas: &Canvas, delay_cs: u16) {
+        assert_eq!((canvas.width, canvas.height), (self.width, self.height));
+        self.bytes.extend_from_slice(&[0x21, 0xF9, 0x04, 0x00]);
+        self.bytes.extend_from_slice(&delay_cs.to_le_bytes());
+        self.bytes
+            .extend_from_slice(&[0x00, 0x00, 0x2C, 0, 0, 0, 0]);
+        self.bytes
+            .extend_from_slice(&(self.width as u16).to_le_bytes());
+        self.bytes
+            .extend_from_slice(&(self.height as u16).to_le_bytes());
+        self.bytes.extend_from_slice(&[0x00, 0x08]);
+        let (mut data, mut acc, mut nbits) = (Vec::new(), 0u32, 0u32);
+        let mut emit = |code: u32, data: &mut Vec<u8>| {
+            acc |= code << nbits;
+            nbits += 9;
+            while nbits >= 8 {
+                data.push(acc as u8);
+                acc >>= 8;
+                nbits -= 8;
+            }
+        };
+        for (i, p) in canvas.pixels.iter().enumerate() {
+            if i % 250 == 0 {
+                emit(256, &mut data);
+            }
+            let q = |c: u8| (u32::from(c) + 25) / 51;
+            emit(q(p[0]) * 36 + q(p[1]) * 6 + q(p[2]), &mut data);
+        }
+        emit(257, &mut data);
+        if nbits > 0 {
+            data.push(acc as u8);
+        }
+        for chunk in data.chunks(255) {
+            self.bytes.push(chunk.len() as u8);
+            self.bytes.extend_from_slice(chunk);
+        }
+        self.bytes.push(0);
+    }
+
+    pub fn save(mut self, path: &Path) -> std::io::Result<()> {
+        self.bytes.push(0x3B);
+        if let Some(dir) = path.parent() {
+            std::fs::create_dir_all(dir)?;
+        }
+        std::fs::write(path, self.bytes)
+    }
 }
