@@ -48,6 +48,7 @@ pub struct BodyQuarantined {
 }
 
 fn report_quarantine(mut world: DeferredWorld, ctx: HookContext) {
+    crate::collision::mark_broad_phase_dirty(&mut world, ctx.entity);
     let Some(reason) = world
         .get::<Quarantined>(ctx.entity)
         .map(|q| q.reason.clone())

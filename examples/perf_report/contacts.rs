@@ -115,7 +115,40 @@ fn falling_window(cfg: &Config, name: &str, specs: &[BoxSpec], steps: usize) {
     );
 }
 
+/// One box bouncing on the ground, with and without 10,000 static boxes around (none
+/// within reach): what idle static geometry costs per step.
+fn idle_statics(cfg: &Config) {
+    let mut with = vec![BoxSpec::ground()];
+    for i in 0..10_000 {
+        let (a, b) = ((i % 100) as f32, (i / 100) as f32);
+        with.push(BoxSpec {
+            half: Vec3::splat(0.4),
+            position: Vec3::new(a * 2.0 - 100.0, 0.4, b * 2.0 + 10.0),
+            rotation: glam::Quat::IDENTITY,
+            fixed: true,
+        });
+    }
+    let body = BoxSpec {
+        half: Vec3::splat(0.5),
+        position: Vec3::new(0.0, 3.0, 0.0),
+        rotation: glam::Quat::IDENTITY,
+        fixed: false,
+    };
+    with.push(body);
+    let without = vec![BoxSpec::ground(), body];
+    let (mut a, _) = ours(&with);
+    let (mut b, _) = ours(&without);
+    let (x, y) = compare(cfg, || a.step_physics(), || b.step_physics());
+    line(
+        "contacts_idle_statics10k_vs_none",
+        x,
+        y,
+        "one moving box; goal ≈ 1.0",
+    );
+}
+
 pub fn contact_scenes(cfg: &Config, quick: bool) {
+    idle_statics(cfg);
     let falling = scenes::falling_boxes_spec(1000);
     falling_window(cfg, "contacts_falling1000_freefall_vs_rapier", &falling, 20);
     steady(

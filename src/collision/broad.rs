@@ -1,7 +1,18 @@
-//! Sort-and-sweep broad phase.
+//! Broad phase: an incremental sort-and-sweep over moving colliders, and a bounding volume
+//! hierarchy over fixed ones.
+//!
+//! - **Moving** colliders (anything with a velocity) keep their order from the last step;
+//!   each step their boxes are updated in place and re-sorted by insertion sort along the
+//!   sweep axis, which for coherent motion is close to O(n). The set is rebuilt (O(n log n))
+//!   only when colliders are added or removed.
+//! - **Fixed** colliders sit in parry's BVH, rebuilt only when one of them is added, moved,
+//!   reshaped or removed. Each awake moving box queries it: O(log n_fixed) per box. A fixed
+//!   collider costs nothing per step while nothing about it changes.
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use parry3d::bounding_volume::Aabb;
+use parry3d::partitioning::{Bvh, BvhBuildStrategy};
 
 use super::CollisionLayers;
 
@@ -11,21 +22,58 @@ pub(crate) struct Entry {
     pub entity: Entity,
     pub min: Vec3,
     pub max: Vec3,
-    /// Whether the collider can move (dynamic or kinematic); two fixed colliders never pair.
-    pub moving: bool,
+    /// False for sleeping bodies: they pair with awake bodies only.
+    pub awake: bool,
     pub layers: CollisionLayers,
 }
 
-/// The broad phase's working set and its output, reused from step to step.
-#[derive(Resource, Default)]
+/// The broad phase's working set and its output, kept from step to step.
+#[derive(Resource)]
 pub(crate) struct BroadPhase {
-    pub entries: Vec<Entry>,
+    /// Moving colliders, sorted along `axis`.
+    pub moving: Vec<Entry>,
+    /// Fixed colliders, in the order of the BVH's leaves.
+    pub fixed: Vec<Entry>,
+    pub fixed_tree: Bvh,
+    /// Set when a fixed collider changed: the tree is rebuilt before the next query.
+    pub fixed_dirty: bool,
+    /// Set when moving colliders were added or removed: their list is rebuilt.
+    pub moving_dirty: bool,
+    pub axis: usize,
     /// Candidate pairs (lower entity first), sorted.
     pub pairs: Vec<(Entity, Entity)>,
 }
 
+impl Default for BroadPhase {
+    /// Both lists start out of date, so colliders spawned before the plugin are picked up.
+    fn default() -> Self {
+        Self {
+            moving: Vec::new(),
+            fixed: Vec::new(),
+            fixed_tree: Bvh::new(),
+            fixed_dirty: true,
+            moving_dirty: true,
+            axis: 0,
+            pairs: Vec::new(),
+        }
+    }
+}
+
+/// Marks both lists out of date. Called from the component hooks of [`super::Collider`],
+/// the validated pose components and [`crate::Quarantined`]: inserts and removals are how the
+/// broad phase learns about changes without scanning every collider each step.
+pub(crate) fn mark_dirty(world: &mut bevy_ecs::world::DeferredWorld, entity: Entity) {
+    if world.get::<super::Collider>(entity).is_none() {
+        return;
+    }
+    if let Some(mut bp) = world.get_resource_mut::<BroadPhase>() {
+        bp.fixed_dirty = true;
+        bp.moving_dirty = true;
+    }
+}
+
 /// The axis along which box centres spread most: sweeping it leaves the fewest overlaps.
-fn sweep_axis(entries: &[Entry]) -> usize {
+pub(crate) fn sweep_axis(entries: &[Entry]) -> usize {
     let n = entries.len().max(1) as f32;
     let mean = entries.iter().map(|e| e.min + e.max).sum::<Vec3>() / (2.0 * n);
     let var = entries
@@ -44,41 +92,77 @@ fn sweep_axis(entries: &[Entry]) -> usize {
     }
 }
 
+fn key(a: Entity, b: Entity) -> (Entity, Entity) {
+    if a < b { (a, b) } else { (b, a) }
+}
+
+fn overlap(a: &Entry, b: &Entry) -> bool {
+    a.min.cmple(b.max).all() && b.min.cmple(a.max).all()
+}
+
 impl BroadPhase {
-    /// Sorts the boxes along the sweep axis and collects every overlapping pair that may
-    /// interact: O(n log n + overlaps along the axis).
+    /// Rebuilds the fixed tree from `self.fixed` if it is out of date.
+    pub fn refresh_fixed(&mut self) {
+        if self.fixed_dirty {
+            let leaves: Vec<Aabb> = self.fixed.iter().map(|e| Aabb::new(e.min, e.max)).collect();
+            self.fixed_tree = Bvh::from_leaves(BvhBuildStrategy::default(), &leaves);
+            self.fixed_dirty = false;
+        }
+    }
+
+    /// Sorts the moving boxes (insertion sort: cheap when they were nearly sorted) and
+    /// collects every overlapping pair that may interact.
     pub fn find_pairs(&mut self) {
-        let axis = sweep_axis(&self.entries);
-        // Ties broken by entity so the order, and so the solver's order, is deterministic.
-        self.entries.sort_unstable_by(|a, b| {
-            a.min[axis]
-                .total_cmp(&b.min[axis])
-                .then(a.entity.cmp(&b.entity))
-        });
+        if self.moving_dirty {
+            self.axis = sweep_axis(&self.moving);
+            let axis = self.axis;
+            self.moving.sort_unstable_by(|a, b| {
+                a.min[axis]
+                    .total_cmp(&b.min[axis])
+                    .then(a.entity.cmp(&b.entity))
+            });
+            self.moving_dirty = false;
+        } else {
+            let axis = self.axis;
+            for i in 1..self.moving.len() {
+                let mut j = i;
+                while j > 0 && {
+                    let (p, q) = (&self.moving[j - 1], &self.moving[j]);
+                    p.min[axis]
+                        .total_cmp(&q.min[axis])
+                        .then(p.entity.cmp(&q.entity))
+                        .is_gt()
+                } {
+                    self.moving.swap(j - 1, j);
+                    j -= 1;
+                }
+            }
+        }
         self.pairs.clear();
-        let (o1, o2) = ((axis + 1) % 3, (axis + 2) % 3);
-        for (i, a) in self.entries.iter().enumerate() {
-            for b in &self.entries[i + 1..] {
+        let axis = self.axis;
+        for (i, a) in self.moving.iter().enumerate() {
+            for b in &self.moving[i + 1..] {
                 if b.min[axis] > a.max[axis] {
                     break;
                 }
-                if !(a.moving || b.moving)
-                    || b.min[o1] > a.max[o1]
-                    || a.min[o1] > b.max[o1]
-                    || b.min[o2] > a.max[o2]
-                    || a.min[o2] > b.max[o2]
-                    || !a.layers.interacts(b.layers)
-                {
-                    continue;
+                if (a.awake || b.awake) && overlap(a, b) && a.layers.interacts(b.layers) {
+                    self.pairs.push(key(a.entity, b.entity));
                 }
-                self.pairs.push(if a.entity < b.entity {
-                    (a.entity, b.entity)
-                } else {
-                    (b.entity, a.entity)
-                });
+            }
+        }
+        self.refresh_fixed();
+        for a in self.moving.iter().filter(|a| a.awake) {
+            let bounds = Aabb::new(a.min, a.max);
+            for leaf in self.fixed_tree.intersect_aabb(&bounds) {
+                if let Some(b) = self.fixed.get(leaf as usize)
+                    && a.layers.interacts(b.layers)
+                {
+                    self.pairs.push(key(a.entity, b.entity));
+                }
             }
         }
         self.pairs.sort_unstable();
+        self.pairs.dedup();
     }
 }
 
@@ -86,42 +170,63 @@ impl BroadPhase {
 mod tests {
     use super::*;
 
-    fn entry(i: u32, min: Vec3, max: Vec3, moving: bool) -> Entry {
+    fn entry(i: u32, min: Vec3, max: Vec3) -> Entry {
         Entry {
             entity: Entity::from_raw_u32(i).unwrap(),
             min,
             max,
-            moving,
+            awake: true,
             layers: CollisionLayers::default(),
         }
     }
 
     #[test]
-    fn finds_exactly_the_overlapping_moving_pairs() {
+    fn finds_exactly_the_overlapping_pairs_and_never_fixed_with_fixed() {
         let mut bp = BroadPhase {
-            entries: vec![
-                entry(1, Vec3::ZERO, Vec3::ONE, true),
-                entry(2, Vec3::splat(0.5), Vec3::splat(1.5), true),
-                entry(3, Vec3::splat(3.0), Vec3::splat(4.0), true),
-                entry(4, Vec3::new(0.5, 5.0, 0.5), Vec3::new(0.9, 6.0, 0.9), true),
-                entry(5, Vec3::splat(-10.0), Vec3::splat(10.0), false),
-                entry(6, Vec3::splat(-1.0), Vec3::splat(0.2), false),
+            moving: vec![
+                entry(1, Vec3::ZERO, Vec3::ONE),
+                entry(2, Vec3::splat(0.5), Vec3::splat(1.5)),
+                entry(3, Vec3::splat(3.0), Vec3::splat(4.0)),
+                entry(4, Vec3::new(0.5, 5.0, 0.5), Vec3::new(0.9, 6.0, 0.9)),
             ],
-            pairs: Vec::new(),
+            fixed: vec![
+                entry(5, Vec3::splat(-10.0), Vec3::splat(10.0)),
+                entry(6, Vec3::splat(-1.0), Vec3::splat(0.2)),
+            ],
+            fixed_dirty: true,
+            moving_dirty: true,
+            ..Default::default()
         };
         bp.find_pairs();
         // Entity order is bevy's, not the index order: compare as sorted index pairs.
-        let mut ids: Vec<(u32, u32)> = bp
-            .pairs
-            .iter()
-            .map(|(a, b)| {
-                let (a, b) = (a.index_u32(), b.index_u32());
-                (a.min(b), a.max(b))
-            })
-            .collect();
-        ids.sort_unstable();
-
-        // 5 and 6 are fixed: they pair with every moving box they touch, never with each other.
-        assert_eq!(ids, vec![(1, 2), (1, 5), (1, 6), (2, 5), (3, 5), (4, 5)]);
+        let ids = |bp: &BroadPhase| {
+            let mut ids: Vec<(u32, u32)> = bp
+                .pairs
+                .iter()
+                .map(|(a, b)| {
+                    let (a, b) = (a.index_u32(), b.index_u32());
+                    (a.min(b), a.max(b))
+                })
+                .collect();
+            ids.sort_unstable();
+            ids
+        };
+        assert_eq!(
+            ids(&bp),
+            vec![(1, 2), (1, 5), (1, 6), (2, 5), (3, 5), (4, 5)]
+        );
+        // Move box 3 onto box 4 (incremental path): the pairs follow.
+        bp.moving[2].min = Vec3::new(0.6, 5.5, 0.6);
+        bp.moving[2].max = Vec3::new(1.6, 6.5, 1.6);
+        bp.find_pairs();
+        assert_eq!(
+            ids(&bp),
+            vec![(1, 2), (1, 5), (1, 6), (2, 5), (3, 4), (3, 5), (4, 5)]
+        );
+        // Asleep with asleep: no pair; asleep with awake or fixed as before.
+        bp.moving[2].awake = false;
+        bp.moving[3].awake = false;
+        bp.find_pairs();
+        assert!(!ids(&bp).contains(&(3, 4)) && !ids(&bp).contains(&(3, 5)));
     }
 }

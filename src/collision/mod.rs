@@ -4,9 +4,10 @@
 //! **Pipeline, once per step** (in [`crate::schedule::PrepareSystems::Collision`]):
 //! 1. bounding boxes of moving colliders, grown by the distance they can travel in the step
 //!    (the *speculative margin*, so fast bodies find what they would hit);
-//! 2. broad phase: sort-and-sweep on the axis along which the boxes spread most,
-//!    O(n log n); static pairs are never formed, and static boxes are recomputed only when
-//!    their pose or shape changes;
+//! 2. broad phase: incremental sort-and-sweep over moving boxes and a tree of fixed ones
+//!    (see the `broad` module). Fixed colliders cost nothing per step: they are meant to stay
+//!    put, and the broad phase hears of a change through component hooks, so move a static
+//!    collider by inserting a new `Position` or `Rotation` (or make it kinematic);
 //! 3. narrow phase: parry's persistent contact manifolds per pair, which carry each contact's
 //!    impulses from step to step by feature id (warm starting); contact start/end messages;
 //! 4. contact constraints with anchors, effective masses and the approach speed.
@@ -35,6 +36,7 @@ mod plugin;
 mod query;
 mod solver;
 
+pub(crate) use broad::mark_dirty as mark_broad_phase_dirty;
 pub use narrow::{ContactPair, Contacts};
 pub use plugin::CollisionPlugin;
 pub use query::{Hit, Projection, QueryFilter, SpatialQuery};
@@ -45,6 +47,7 @@ use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
 use crate::error::{Error, Result, finite, finite_vec, non_negative};
+
 use crate::particles::Position;
 use crate::quarantine::{Validate, validate_on_insert};
 use crate::rigid::Rotation;
@@ -61,6 +64,7 @@ use crate::rigid::Rotation;
     ColliderAabb,
     crate::sleep::SleepTimer
 )]
+#[component(on_insert = collider_changed, on_remove = collider_changed)]
 pub struct Collider {
     shape: SharedShape,
 }
@@ -69,6 +73,13 @@ impl std::fmt::Debug for Collider {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "Collider({:?})", self.shape.shape_type())
     }
+}
+
+fn collider_changed(
+    mut world: bevy_ecs::world::DeferredWorld,
+    ctx: bevy_ecs::lifecycle::HookContext,
+) {
+    broad::mark_dirty(&mut world, ctx.entity);
 }
 
 impl Collider {

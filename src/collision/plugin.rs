@@ -43,7 +43,7 @@ impl Plugin for CollisionPlugin {
             PhysicsSchedule,
             (
                 update_moving_aabbs,
-                update_fixed_aabbs,
+                update_fixed_aabbs.run_if(fixed_dirty),
                 run_broad_phase,
                 update_contacts,
                 prepare_contacts,
@@ -112,26 +112,23 @@ fn update_moving_aabbs(
     }
 }
 
-type FixedChanged = (
-    Without<LinearVelocity>,
-    Or<(Changed<Position>, Changed<Rotation>, Changed<Collider>)>,
-    Live,
+type Fixed = (Without<LinearVelocity>, Live);
+
+fn fixed_dirty(bp: Res<BroadPhase>) -> bool {
+    bp.fixed_dirty
+}
+
+type FixedBox<'a> = (
+    &'a Collider,
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    &'a mut ColliderAabb,
 );
 
-/// Boxes of fixed colliders: recomputed only when they were moved or reshaped.
-fn update_fixed_aabbs(
-    settings: Res<ContactSettings>,
-    mut colliders: Query<
-        (
-            &Collider,
-            &Position,
-            &Rotation,
-            Option<&CenterOfMass>,
-            &mut ColliderAabb,
-        ),
-        FixedChanged,
-    >,
-) {
+/// Boxes of fixed colliders: recomputed only after a collider was inserted or removed or a
+/// pose was inserted (the hooks set the flag), so idle static geometry costs nothing.
+fn update_fixed_aabbs(settings: Res<ContactSettings>, mut colliders: Query<FixedBox, Fixed>) {
     for (c, x, q, com, mut aabb) in &mut colliders {
         let b = c.shape().compute_aabb(&shape_pose(x.0, q.0, com));
         *aabb = ColliderAabb {
@@ -141,28 +138,46 @@ fn update_fixed_aabbs(
     }
 }
 
-type BroadCollider<'a> = (
-    Entity,
-    &'a ColliderAabb,
-    &'a CollisionLayers,
-    Has<LinearVelocity>,
-    Has<Sleeping>,
-);
+type BroadCollider<'a> = (Entity, &'a ColliderAabb, &'a CollisionLayers, Has<Sleeping>);
 
+fn entry(
+    (entity, aabb, layers, sleeping): (Entity, &ColliderAabb, &CollisionLayers, bool),
+) -> Entry {
+    Entry {
+        entity,
+        min: aabb.min,
+        max: aabb.max,
+        awake: !sleeping,
+        layers: *layers,
+    }
+}
+
+/// Keeps the broad phase's lists current: moving boxes in place, rebuilding a list only
+/// when colliders were added, removed or quarantined.
 fn run_broad_phase(
     mut bp: ResMut<BroadPhase>,
-    colliders: Query<BroadCollider, (With<Collider>, Live)>,
+    moving: Query<BroadCollider, (With<Collider>, With<LinearVelocity>, Live)>,
+    fixed: Query<BroadCollider, (With<Collider>, Without<LinearVelocity>, Live)>,
 ) {
-    bp.entries.clear();
-    for (entity, aabb, layers, has_velocity, sleeping) in &colliders {
-        let moving = has_velocity && !sleeping;
-        bp.entries.push(Entry {
-            entity,
-            min: aabb.min,
-            max: aabb.max,
-            moving,
-            layers: *layers,
-        });
+    let bp = &mut *bp;
+    if !bp.moving_dirty {
+        for e in &mut bp.moving {
+            match moving.get(e.entity) {
+                Ok(c) => *e = entry(c),
+                Err(_) => {
+                    bp.moving_dirty = true;
+                    break;
+                }
+            }
+        }
+    }
+    if bp.moving_dirty {
+        bp.moving.clear();
+        bp.moving.extend(moving.iter().map(entry));
+    }
+    if bp.fixed_dirty {
+        bp.fixed.clear();
+        bp.fixed.extend(fixed.iter().map(entry));
     }
     bp.find_pairs();
 }
