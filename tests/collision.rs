@@ -393,3 +393,80 @@ fn a_static_collider_moves_when_its_position_is_inserted_again() {
         pos(&w, ball)
     );
 }
+
+#[test]
+fn nan_in_one_box_of_a_stack_does_not_cross_the_contacts() {
+    let mut w = world(4);
+    scenes::ground(&mut w).unwrap();
+    let boxes: Vec<Entity> = (0..3)
+        .map(|i| {
+            scenes::dynamic_box(
+                &mut w,
+                Vec3::splat(0.5),
+                Vec3::new(0.0, 0.5 + i as f32, 0.0),
+            )
+            .unwrap()
+        })
+        .collect();
+    for _ in 0..30 {
+        w.step_physics();
+    }
+    // Game code writes NaN into the middle box's velocity through a mutable borrow.
+    w.get_mut::<LinearVelocity>(boxes[1]).unwrap().0 = glam::Vec3A::NAN;
+    for _ in 0..60 {
+        w.step_physics();
+    }
+    assert!(w.get::<hooke::Quarantined>(boxes[1]).is_some());
+    for &b in [boxes[0], boxes[2]].iter() {
+        assert!(
+            pos(&w, b).is_finite() && vel(&w, b).is_finite(),
+            "NaN crossed into {b}"
+        );
+        assert!(w.get::<hooke::Quarantined>(b).is_none());
+    }
+}
+
+#[derive(Component)]
+struct Poisoned;
+
+fn poison(mut bodies: Query<&mut Force, With<Poisoned>>) {
+    for mut f in &mut bodies {
+        f.0 = glam::Vec3A::NAN;
+    }
+}
+
+#[test]
+fn nan_born_mid_step_from_a_force_does_not_cross_the_contacts() {
+    let mut w = world(4);
+    scenes::ground(&mut w).unwrap();
+    let boxes: Vec<Entity> = (0..3)
+        .map(|i| {
+            scenes::dynamic_box(
+                &mut w,
+                Vec3::splat(0.5),
+                Vec3::new(0.0, 0.5 + i as f32, 0.0),
+            )
+            .unwrap()
+        })
+        .collect();
+    hooke::schedule::add_force_systems(&mut w, || poison.in_set(hooke::ForceSystems::User));
+    for _ in 0..30 {
+        w.step_physics();
+    }
+    // From now on a game force system writes NaN into the middle box, inside the substeps.
+    w.entity_mut(boxes[1]).insert(Poisoned);
+    for _ in 0..30 {
+        w.step_physics();
+    }
+    assert!(w.get::<hooke::Quarantined>(boxes[1]).is_some());
+    for &b in [boxes[0], boxes[2]].iter() {
+        assert!(
+            pos(&w, b).is_finite() && vel(&w, b).is_finite(),
+            "NaN crossed into {b}"
+        );
+        assert!(
+            w.get::<hooke::Quarantined>(b).is_none(),
+            "{b} was quarantined too"
+        );
+    }
+}

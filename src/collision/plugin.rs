@@ -297,10 +297,14 @@ fn body_index(
         return i;
     }
     let (x, q, _, mass, v, inertia, w, _, _, sleeping) = *b;
-    // A sleeping body holds still like a static one until its island wakes.
+    // A sleeping body holds still like a static one until its island wakes; a non-finite
+    // one (about to be quarantined) is kept out of the solver altogether.
     let (Some(mass), Some(v), false) = (mass, v, sleeping) else {
         return FIXED;
     };
+    if !(x.0.is_finite() && v.0.is_finite() && q.0.is_finite()) {
+        return FIXED;
+    }
     let inv_i = inertia.map_or(Mat3::ZERO, |i| i.world_inverse_tensor(q.0));
     let dynamic = !mass.is_pinned();
     let i = solver.bodies.len() as u32;
@@ -466,6 +470,14 @@ fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
             _ => w.map_or(Vec3A::ZERO, |w| w.0),
         };
         b.ang = Vec3A::ZERO;
+        if !(b.v.is_finite() && b.w.is_finite() && b.dx.is_finite() && b.dr.is_finite()) {
+            // A body that turned non-finite inside the step (it is quarantined at the next
+            // position pass) must not pass NaN through its contacts: for the rest of the
+            // step it is an immovable, motionless obstacle and is never written back.
+            b.dynamic = false;
+            b.inv_mass = 0.0;
+            (b.v, b.w, b.dx, b.dr) = (Vec3A::ZERO, Vec3A::ZERO, Vec3A::ZERO, Mat3::IDENTITY);
+        }
     }
 }
 
