@@ -412,3 +412,21 @@ pub fn pile_scene(
     }
     Ok(out)
 }
+
+/// The ground and a column of `n` unit boxes resting on it, bottom first.
+#[must_use]
+pub fn column_spec(n: usize) -> Vec<BoxSpec> {
+    let mut out = vec![BoxSpec::ground()];
+    out.extend(
+        (0..n).map(|i| BoxSpec::dynamic(Vec3::splat(0.5), Vec3::new(0.0, 0.5 + i as f32, 0.0))),
+    );
+    out
+}
+
+/// [`column_spec`], spawned; returns the boxes, bottom first.
+///
+/// # Errors
+/// As [`spawn_boxes`].
+pub fn box_column(world: &mut World, n: usize) -> Result<Vec<Entity>> {
+    spawn_boxes(world, &column_spec(n))
+}

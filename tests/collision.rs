@@ -112,17 +112,7 @@ fn stack_of_ten_boxes_stands_for_ten_seconds() {
     // 8 substeps allow the 60 Hz contact; at the default 4 the contacts run at 30 Hz and the
     // stack compresses 11.3 mm in its first second, then holds within 0.1 mm (measured).
     let mut w = world(8);
-    scenes::ground(&mut w).unwrap();
-    let boxes: Vec<Entity> = (0..10)
-        .map(|i| {
-            scenes::dynamic_box(
-                &mut w,
-                Vec3::splat(0.5),
-                Vec3::new(0.0, 0.5 + i as f32, 0.0),
-            )
-            .unwrap()
-        })
-        .collect();
+    let boxes = scenes::box_column(&mut w, 10).unwrap();
     w.step_physics();
     let top0 = pos(&w, boxes[9]);
     for _ in 0..600 {
@@ -397,17 +387,7 @@ fn a_static_collider_moves_when_its_position_is_inserted_again() {
 #[test]
 fn nan_in_one_box_of_a_stack_does_not_cross_the_contacts() {
     let mut w = world(4);
-    scenes::ground(&mut w).unwrap();
-    let boxes: Vec<Entity> = (0..3)
-        .map(|i| {
-            scenes::dynamic_box(
-                &mut w,
-                Vec3::splat(0.5),
-                Vec3::new(0.0, 0.5 + i as f32, 0.0),
-            )
-            .unwrap()
-        })
-        .collect();
+    let boxes = scenes::box_column(&mut w, 3).unwrap();
     for _ in 0..30 {
         w.step_physics();
     }
@@ -438,17 +418,7 @@ fn poison(mut bodies: Query<&mut Force, With<Poisoned>>) {
 #[test]
 fn nan_born_mid_step_from_a_force_does_not_cross_the_contacts() {
     let mut w = world(4);
-    scenes::ground(&mut w).unwrap();
-    let boxes: Vec<Entity> = (0..3)
-        .map(|i| {
-            scenes::dynamic_box(
-                &mut w,
-                Vec3::splat(0.5),
-                Vec3::new(0.0, 0.5 + i as f32, 0.0),
-            )
-            .unwrap()
-        })
-        .collect();
+    let boxes = scenes::box_column(&mut w, 3).unwrap();
     hooke::schedule::add_force_systems(&mut w, || poison.in_set(hooke::ForceSystems::User));
     for _ in 0..30 {
         w.step_physics();
