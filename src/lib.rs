@@ -97,7 +97,11 @@ pub mod prelude {
         PhysicsDiagnostics, PhysicsPlugins, PhysicsTime, PhysicsWorldExt, Plugin, Position,
         QuarantineReason, Quarantined, Spring, SpringNetwork, Tracer, VelocityField,
     };
-    pub use glam::{Vec3, Vec3A};
+    pub use crate::{
+        AngularVelocity, Collider, CollisionLayers, Contacts, Friction, Inertia, MassProperties,
+        Restitution, RigidBody, RigidBodyBundle, Rotation, Sensor, Sleeping, SpatialQuery,
+    };
+    pub use glam::{Quat, Vec3, Vec3A};
 }
 
 /// A piece of physics that installs itself into a `World`: resources and systems.
