@@ -427,6 +427,7 @@ fn prepare_contacts(
                     t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
                     max_n: 0.0,
                     approach: n.dot(rel),
+                    vn_seen: [f32::NAN; 2],
                 });
             }
             s.manifolds.push(ManifoldConstraint {

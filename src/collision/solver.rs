@@ -81,8 +81,12 @@ pub(crate) struct PointConstraint {
     pub n_imp: f32,
     pub t_imp: [f32; 2],
     pub max_n: f32,
-    /// Relative normal velocity at the start of the step (negative when approaching).
+    /// Relative normal velocity at the start of the step (negative when approaching), then
+    /// the speed of impact once the contact first pushes.
     pub approach: f32,
+    /// Normal velocity seen by the last two biased passes (one substep apart): their
+    /// difference is the approach acceleration, used to extrapolate the speed of impact.
+    pub vn_seen: [f32; 2],
 }
 
 #[derive(Debug, Clone, Copy)]
@@ -137,6 +141,21 @@ impl Softness {
             mass_scale: a2 * a3,
             impulse_scale: a3,
         }
+    }
+}
+
+/// The normal velocity of impact for a contact's first push. A speculative contact (gap
+/// `s` > 0 still open) stops the body up to a substep before it would have arrived, while
+/// it was still accelerating: with the approach acceleration a measured between the last two
+/// biased passes (one substep apart), the speed it would have hit with is √(vn² + 2|a|s).
+/// Restitution bounces from that speed (without it a ball dropped 1 m with e = 0.8 rose
+/// 0.617 m instead of 0.64 at 4 substeps).
+fn impact_speed(vn: f32, s: f32, seen: [f32; 2], inv_h: f32) -> f32 {
+    let a = (seen[1] - seen[0]) * inv_h;
+    if s > 0.0 && vn < 0.0 && a < 0.0 && a.is_finite() {
+        -(vn * vn - 2.0 * a * s).sqrt()
+    } else {
+        vn
     }
 }
 
@@ -269,13 +288,14 @@ impl ContactSolver {
                     (0.0, 1.0, 0.0)
                 };
                 let vn = Side::along(&a, &b, m.n, &p.normal);
+                if use_bias {
+                    p.vn_seen = [p.vn_seen[1], vn];
+                }
                 let imp = -p.normal.mass * mass_scale * (vn + bias) - impulse_scale * p.n_imp;
                 let total = (p.n_imp + imp).max(0.0);
                 let imp = total - p.n_imp;
                 if p.max_n == 0.0 && imp > 0.0 {
-                    // The first push of the step: vn is the speed of impact, which a
-                    // speculative contact reaches up to a step after the step began.
-                    p.approach = p.approach.min(vn);
+                    p.approach = p.approach.min(impact_speed(vn, s, p.vn_seen, inv_h));
                 }
                 p.n_imp = total;
                 p.max_n = p.max_n.max(imp);
