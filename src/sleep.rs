@@ -142,6 +142,16 @@ fn update_islands(
     springs: Query<&Spring>,
     mut bodies: Query<SleepBody, (With<Collider>, Without<Quarantined>)>,
 ) {
+    if !settings.enabled {
+        // No islands to build; just make sure nothing stays asleep.
+        for (e, .., mut timer, sleeping, _) in &mut bodies {
+            timer.0 = 0.0;
+            if sleeping {
+                commands.entity(e).remove::<Sleeping>();
+            }
+        }
+        return;
+    }
     let dt = time.dt();
     let mut index = HashMap::new();
     let mut still = Vec::new();

@@ -105,6 +105,15 @@ fn sleeping_can_be_disabled_per_body_and_per_world() {
         w.step_physics();
     }
     assert!(!asleep(&w, b));
+    // Switching sleeping off wakes whatever was asleep.
+    w.resource_mut::<SleepSettings>().enabled = true;
+    for _ in 0..90 {
+        w.step_physics();
+    }
+    assert!(asleep(&w, b));
+    w.resource_mut::<SleepSettings>().enabled = false;
+    w.step_physics();
+    assert!(!asleep(&w, b));
 }
 
 #[test]
