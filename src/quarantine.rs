@@ -65,6 +65,13 @@ fn report_quarantine(mut world: DeferredWorld, ctx: HookContext) {
     });
 }
 
+/// Quarantines `entity` because its state turned non-finite during a step.
+pub(crate) fn quarantine_non_finite(commands: &mut Commands, entity: Entity) {
+    commands.entity(entity).insert(Quarantined {
+        reason: QuarantineReason::NonFiniteState,
+    });
+}
+
 /// A component whose value can be checked after a direct insert.
 pub(crate) trait Validate {
     fn validate(&self) -> Result<(), Error>;

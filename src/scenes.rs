@@ -171,13 +171,33 @@ pub fn tumbling_boxes(world: &mut World, n: usize) -> Result<()> {
 /// # Errors
 /// None in practice.
 pub fn ground(world: &mut World) -> Result<Entity> {
-    let g = BoxSpec::ground();
-    Ok(world
-        .spawn((
-            crate::RigidBodyBundle::fixed(g.position, g.rotation)?,
-            crate::Collider::cuboid(g.half.x, g.half.y, g.half.z)?,
-        ))
-        .id())
+    spawn_box(world, &BoxSpec::ground())
+}
+
+/// Spawns `collider` at `position` and `rotation`: static when `fixed`, otherwise a dynamic
+/// body of density 1000 kg/m³. Every scene's bodies come through here.
+fn spawn_body(
+    world: &mut World,
+    collider: crate::Collider,
+    position: Vec3,
+    rotation: glam::Quat,
+    fixed: bool,
+) -> Result<Entity> {
+    if fixed {
+        return Ok(world
+            .spawn((crate::RigidBodyBundle::fixed(position, rotation)?, collider))
+            .id());
+    }
+    let props = crate::MassProperties::from_shape(&**collider.shape(), 1000.0)?;
+    let body = crate::RigidBodyBundle::dynamic(props)?
+        .at(position)?
+        .with_rotation(rotation)?;
+    Ok(world.spawn((body, collider)).id())
+}
+
+fn spawn_box(world: &mut World, b: &BoxSpec) -> Result<Entity> {
+    let collider = crate::Collider::cuboid(b.half.x, b.half.y, b.half.z)?;
+    spawn_body(world, collider, b.position, b.rotation, b.fixed)
 }
 
 /// A dynamic box with half extents `half` (m) and density 1000 kg/m³ at `x`.
@@ -185,11 +205,7 @@ pub fn ground(world: &mut World) -> Result<Entity> {
 /// # Errors
 /// Constructor errors for bad sizes.
 pub fn dynamic_box(world: &mut World, half: Vec3, x: Vec3) -> Result<Entity> {
-    let collider = crate::Collider::cuboid(half.x, half.y, half.z)?;
-    let props = crate::MassProperties::from_shape(&**collider.shape(), 1000.0)?;
-    Ok(world
-        .spawn((crate::RigidBodyBundle::dynamic(props)?.at(x)?, collider))
-        .id())
+    spawn_box(world, &BoxSpec::dynamic(half, x))
 }
 
 /// A dynamic ball of radius `r` (m), density 1000 kg/m³, at `x`.
@@ -197,11 +213,13 @@ pub fn dynamic_box(world: &mut World, half: Vec3, x: Vec3) -> Result<Entity> {
 /// # Errors
 /// Constructor errors for bad sizes.
 pub fn dynamic_ball(world: &mut World, r: f32, x: Vec3) -> Result<Entity> {
-    let collider = crate::Collider::ball(r)?;
-    let props = crate::MassProperties::from_shape(&**collider.shape(), 1000.0)?;
-    Ok(world
-        .spawn((crate::RigidBodyBundle::dynamic(props)?.at(x)?, collider))
-        .id())
+    spawn_body(
+        world,
+        crate::Collider::ball(r)?,
+        x,
+        glam::Quat::IDENTITY,
+        false,
+    )
 }
 
 /// One box of a contact scene, so that hooke and a reference engine build the same bodies.
@@ -246,18 +264,9 @@ impl BoxSpec {
 pub fn spawn_boxes(world: &mut World, specs: &[BoxSpec]) -> Result<Vec<Entity>> {
     let mut out = Vec::new();
     for b in specs {
-        let collider = crate::Collider::cuboid(b.half.x, b.half.y, b.half.z)?;
-        if b.fixed {
-            world.spawn((
-                crate::RigidBodyBundle::fixed(b.position, b.rotation)?,
-                collider,
-            ));
-        } else {
-            let props = crate::MassProperties::from_shape(&**collider.shape(), 1000.0)?;
-            let body = crate::RigidBodyBundle::dynamic(props)?
-                .at(b.position)?
-                .with_rotation(b.rotation)?;
-            out.push(world.spawn((body, collider)).id());
+        let e = spawn_box(world, b)?;
+        if !b.fixed {
+            out.push(e);
         }
     }
     Ok(out)

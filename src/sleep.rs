@@ -133,30 +133,49 @@ type SleepBody<'a> = (
     Has<SleepingDisabled>,
 );
 
+/// Buffers of [`update_islands`], kept so the per-step pass does not allocate.
+#[derive(Default)]
+struct IslandScratch {
+    index: HashMap<Entity, usize>,
+    still: Vec<bool>,
+    asleep: Vec<bool>,
+    entities: Vec<Entity>,
+    parent: Vec<usize>,
+    island_still: Vec<bool>,
+}
+
 /// Timers, islands, and the sleep/wake decisions.
+#[allow(clippy::too_many_arguments)] // system parameters: queries, resources and a Local
 fn update_islands(
     mut commands: Commands,
     settings: Res<SleepSettings>,
     time: Res<PhysicsTime>,
     contacts: Res<Contacts>,
     springs: Query<&Spring>,
+    sleepers: Query<Entity, With<Sleeping>>,
     mut bodies: Query<SleepBody, (With<Collider>, Without<Quarantined>)>,
+    mut scratch: Local<IslandScratch>,
 ) {
     if !settings.enabled {
         // No islands to build; just make sure nothing stays asleep.
-        for (e, .., mut timer, sleeping, _) in &mut bodies {
-            timer.0 = 0.0;
-            if sleeping {
-                commands.entity(e).remove::<Sleeping>();
-            }
+        for e in &sleepers {
+            commands.entity(e).remove::<Sleeping>();
         }
         return;
     }
     let dt = time.dt();
-    let mut index = HashMap::new();
-    let mut still = Vec::new();
-    let mut asleep = Vec::new();
-    let mut entities = Vec::new();
+    let IslandScratch {
+        index,
+        still,
+        asleep,
+        entities,
+        parent,
+        island_still,
+    } = &mut *scratch;
+    index.clear();
+    still.clear();
+    asleep.clear();
+    entities.clear();
     for (e, m, v, w, _, mut timer, sleeping, disabled) in &mut bodies {
         if m.is_pinned() {
             continue;
@@ -184,22 +203,24 @@ fn update_islands(
             }
         }
     }
-    let mut parent: Vec<usize> = (0..entities.len()).collect();
+    parent.clear();
+    parent.extend(0..entities.len());
     for (a, b) in contacts.touching() {
         if let (Some(&i), Some(&j)) = (index.get(&a), index.get(&b)) {
-            let (ri, rj) = (find(&mut parent, i), find(&mut parent, j));
+            let (ri, rj) = (find(parent, i), find(parent, j));
             if ri != rj {
                 parent[ri.max(rj)] = ri.min(rj);
             }
         }
     }
-    let mut island_still = vec![true; entities.len()];
+    island_still.clear();
+    island_still.resize(entities.len(), true);
     for (i, &s) in still.iter().enumerate() {
-        let r = find(&mut parent, i);
+        let r = find(parent, i);
         island_still[r] &= s;
     }
     for i in 0..entities.len() {
-        let r = find(&mut parent, i);
+        let r = find(parent, i);
         let e = entities[i];
         if island_still[r] && !asleep[i] {
             if let Ok((_, _, mut v, w, l, ..)) = bodies.get_mut(e) {

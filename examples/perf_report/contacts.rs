@@ -13,14 +13,7 @@ use rapier3d::prelude as rp;
 use crate::timing::{Config, compare, line, median};
 
 fn ours(specs: &[BoxSpec]) -> (World, Vec<Entity>) {
-    let mut world = scenes::world_with(
-        1.0 / 60.0,
-        4,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -9.81, 0.0),
-    )
-    .unwrap();
-    world.resource_mut::<DiagnosticsSettings>().energy = false;
+    let mut world = crate::quiet_world(1.0 / 60.0, 4, Integrator::SymplecticEuler);
     world.resource_mut::<hooke::SleepSettings>().enabled = false;
     let boxes = scenes::spawn_boxes(&mut world, specs).unwrap();
     (world, boxes)

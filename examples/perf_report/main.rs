@@ -22,7 +22,9 @@ use hooke::prelude::*;
 use hooke::scenes;
 use timing::{Config, compare, line};
 
-fn quiet_world(dt: f32, substeps: u32, integrator: Integrator) -> World {
+/// A world with every plugin and gravity, without the energy pass: the setup of every
+/// timed scene.
+pub(crate) fn quiet_world(dt: f32, substeps: u32, integrator: Integrator) -> World {
     let mut world =
         scenes::world_with(dt, substeps, integrator, Vec3::new(0.0, -9.81, 0.0)).unwrap();
     // The energy pass reads every body once more per step; the references don't do it.

@@ -2,7 +2,7 @@
 
 use std::hint::black_box;
 
-use glam::{Quat, Vec3, Vec3A};
+use glam::{Quat, Vec3A};
 use hooke::prelude::*;
 use hooke::rigid::free_rotation_split;
 use hooke::{Inertia, MassProperties, scenes};
@@ -77,14 +77,7 @@ fn rapier_world(n: usize, props: &MassProperties) -> rp::PhysicsWorld {
 pub fn rigid_free(cfg: &Config, n: usize) {
     let (half, density) = scenes::TUMBLING_BOX;
     let props = MassProperties::from_shape(&Cuboid::new(half), density).unwrap();
-    let mut world = scenes::world_with(
-        1.0 / 60.0,
-        1,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -9.81, 0.0),
-    )
-    .unwrap();
-    world.resource_mut::<DiagnosticsSettings>().energy = false;
+    let mut world = crate::quiet_world(1.0 / 60.0, 1, Integrator::SymplecticEuler);
     scenes::tumbling_boxes(&mut world, n).unwrap();
     world.step_physics();
     let mut raw = RawBodies::new(n, props.inertia);

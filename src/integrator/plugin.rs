@@ -8,7 +8,7 @@ use crate::particles::{
     ExternalForce, ExternalImpulse, Force, Gravity, GravityScale, LinearVelocity, Mass, Nodes,
     Position,
 };
-use crate::quarantine::{QuarantineReason, Quarantined};
+use crate::quarantine::{Quarantined, quarantine_non_finite};
 use crate::rigid::{
     AngularMomentum, CenterOfMass, ExternalImpulseAtPoint, ExternalTorque, Inertia, Rotation,
     Torque, world_point,
@@ -252,12 +252,6 @@ fn body_velocity_phase(
         x.0 = xa;
     }
     v.0 = va;
-}
-
-fn quarantine_non_finite(commands: &mut Commands, entity: Entity) {
-    commands.entity(entity).insert(Quarantined {
-        reason: QuarantineReason::NonFiniteState,
-    });
 }
 
 type Drift<'a> = (&'a mut Position, &'a LinearVelocity);

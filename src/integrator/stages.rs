@@ -140,11 +140,6 @@ type StageRotation<'a> = (
     Option<&'a IntegratorOverride>,
 );
 
-/// ω at a stage state: from L, or the user's ω for infinite inertia.
-fn stage_omega(inertia: &Inertia, q: Quat, l: Vec3A, stored: Vec3A) -> Vec3A {
-    crate::rigid::omega_of(inertia, q, l, stored)
-}
-
 /// Verlet's second kick and RK4's stages 2–4.
 pub(crate) fn complete_stages(
     world: &mut World,
@@ -195,7 +190,7 @@ pub(crate) fn complete_stages(
         match o.map_or(global, |o| o.0) {
             Integrator::Rk4 => {
                 let mut r = AngularRk4::begin(q.0, l.0);
-                let omega = stage_omega(inertia, q.0, l.0, w.0);
+                let omega = crate::rigid::omega_of(inertia, q.0, l.0, w.0);
                 let tau = if inertia.is_infinite() {
                     Vec3A::ZERO
                 } else {

@@ -7,7 +7,7 @@ use super::fields::{Advection, Gravity, VelocityField};
 use super::{Force, LinearDamping, LinearVelocity, Mass, Position, Tracer};
 use crate::Plugin;
 use crate::integrator::{advect_euler, advect_midpoint, advect_rk4};
-use crate::quarantine::{QuarantineReason, Quarantined};
+use crate::quarantine::{Quarantined, quarantine_non_finite};
 use crate::schedule::{ForceSystems, StepSystems, SubstepSchedule, add_force_systems, add_systems};
 use crate::time::SubstepTime;
 
@@ -90,9 +90,7 @@ fn advect_tracers(
         if x.is_finite() {
             p.0 = x;
         } else {
-            commands.entity(e).insert(Quarantined {
-                reason: QuarantineReason::NonFiniteState,
-            });
+            quarantine_non_finite(&mut commands, e);
         }
     }
 }

@@ -11,7 +11,7 @@ use super::{
 use crate::Plugin;
 use crate::integrator::{Integrator, IntegratorOverride};
 use crate::particles::{Force, LinearVelocity, Position};
-use crate::quarantine::{QuarantineReason, Quarantined};
+use crate::quarantine::{Quarantined, quarantine_non_finite};
 use crate::schedule::{
     ForceSystems, IntegrationSystems, PhysicsSchedule, PrepareSystems, StepSystems,
     SubstepSchedule, add_force_systems, add_systems,
@@ -230,9 +230,7 @@ fn integrate_orientations(
         }
 
         if !(q.0.is_finite() && l.0.is_finite()) {
-            commands.entity(e).insert(Quarantined {
-                reason: QuarantineReason::NonFiniteState,
-            });
+            quarantine_non_finite(&mut commands, e);
         }
     }
 }
