@@ -6,6 +6,7 @@
 //!
 //! ```text
 //! cargo run --release --example perf_report -- --quick
+//! cargo run --release --example perf_report -- --only contacts
 //! ```
 
 mod contacts;
@@ -375,15 +376,28 @@ fn main() {
         "{:<48} {:>14} {:>14} {:>7}  note",
         "name", "ours_ns", "reference_ns", "ratio"
     );
-    particles_vs_raw(&cfg, 100_000);
-    particles_vs_raw(&cfg, 1_000_000);
-    cloth_springs(&cfg, 316);
-    empty_world(&cfg);
-    all_plugins_vs_needed(&cfg, 100_000);
-    rigid::rigid_free(&cfg, 1_000);
-    rigid::rigid_free(&cfg, 100_000);
-    contacts::contact_scenes(&cfg, quick);
-
-    accuracy_dial(&cfg);
+    // `--only particles|rigid|contacts|dial` runs one group.
+    let only = std::env::args()
+        .skip_while(|a| a != "--only")
+        .nth(1)
+        .unwrap_or_default();
+    let run = |group: &str| only.is_empty() || only == group;
+    if run("particles") {
+        particles_vs_raw(&cfg, 100_000);
+        particles_vs_raw(&cfg, 1_000_000);
+        cloth_springs(&cfg, 316);
+        empty_world(&cfg);
+        all_plugins_vs_needed(&cfg, 100_000);
+    }
+    if run("rigid") {
+        rigid::rigid_free(&cfg, 1_000);
+        rigid::rigid_free(&cfg, 100_000);
+    }
+    if run("contacts") {
+        contacts::contact_scenes(&cfg, quick);
+    }
+    if run("dial") {
+        accuracy_dial(&cfg);
+    }
     println!("\n# total {:.1} s", start.elapsed().as_secs_f64());
 }

@@ -31,6 +31,7 @@
 //! Units: m, s, kg; impulses in N·s.
 
 mod broad;
+mod lanes;
 mod narrow;
 mod plugin;
 mod query;

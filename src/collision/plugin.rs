@@ -8,7 +8,7 @@ use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 use super::broad::{BroadPhase, Entry};
 use super::narrow::{ContactImpulse, Contacts, PairState};
 use super::solver::{
-    Axis, ContactSolver, FIXED, ManifoldConstraint, PointConstraint, Softness, SolverBody,
+    BodyState, ContactSolver, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody,
 };
 use super::{
     Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted,
@@ -305,20 +305,21 @@ fn body_index(
     if !(x.0.is_finite() && v.0.is_finite() && q.0.is_finite()) {
         return FIXED;
     }
-    let inv_i = inertia.map_or(Mat3::ZERO, |i| i.world_inverse_tensor(q.0));
+    // A kinematic body drives its contacts but takes no impulse: zero inverse mass and
+    // inertia make every push on it exactly nothing.
     let dynamic = !mass.is_pinned();
+    let inv_i = match inertia {
+        Some(i) if dynamic => i.world_inverse_tensor(q.0),
+        _ => Mat3::ZERO,
+    };
     let i = solver.bodies.len() as u32;
     solver.bodies.push(SolverBody {
         entity: e,
-        inv_mass: mass.inverse(),
+        inv_mass: if dynamic { mass.inverse() } else { 0.0 },
         inv_i,
         x0: x.0,
         q0: q.0,
-        dx: Vec3A::ZERO,
-        dr: Mat3::IDENTITY,
-        v: v.0,
-        w: w.map_or(Vec3A::ZERO, |w| w.0),
-        ang: Vec3A::ZERO,
+        w_in: w.map_or(Vec3A::ZERO, |w| w.0),
         dynamic,
     });
     solver.index.insert(e, i);
@@ -366,10 +367,7 @@ fn prepare_contacts(
     bodies: Query<PreparedBody, (With<Collider>, Live)>,
 ) {
     let s = &mut *solver;
-    s.bodies.clear();
-    s.manifolds.clear();
-    s.points.clear();
-    s.index.clear();
+    s.clear();
     for &(ea, eb) in &bp.pairs {
         let Some(state) = contacts.pairs.get(&(ea, eb)) else {
             continue;
@@ -384,18 +382,17 @@ fn prepare_contacts(
         if ia == FIXED && ib == FIXED {
             continue;
         }
-        let get = |s: &ContactSolver, i: u32| s.bodies.get(i as usize).copied();
-        let (ba, bb) = (get(s, ia), get(s, ib));
-        let (ma, mb) = (
-            ba.map_or(0.0, |b| b.inv_mass),
-            bb.map_or(0.0, |b| b.inv_mass),
-        );
-        let (iia, iib) = (
-            ba.map_or(Mat3::ZERO, |b| b.inv_i),
-            bb.map_or(Mat3::ZERO, |b| b.inv_i),
-        );
-        let (va, wa) = ba.map_or((Vec3A::ZERO, Vec3A::ZERO), |b| (b.v, b.w));
-        let (vb, wb) = bb.map_or((Vec3A::ZERO, Vec3A::ZERO), |b| (b.v, b.w));
+        let velocity = |b: &bevy_ecs::query::QueryItem<'_, '_, PreparedBody<'_>>, i: u32| {
+            if i == FIXED {
+                (Vec3A::ZERO, Vec3A::ZERO)
+            } else {
+                (
+                    b.4.map_or(Vec3A::ZERO, |v| v.0),
+                    b.6.map_or(Vec3A::ZERO, |w| w.0),
+                )
+            }
+        };
+        let ((va, wa), (vb, wb)) = (velocity(&a, ia), velocity(&b, ib));
         let pose_a = shape_pose(a.0.0, a.1.0, a.2);
         let pose_b = shape_pose(b.0.0, b.1.0, b.2);
         let friction = settings.friction_rule.combine(a.7.0, b.7.0);
@@ -406,7 +403,7 @@ fn prepare_contacts(
             }
             let n = Vec3A::from(pose_a.rotation * m.local_n1);
             let t = tangent_basis(n, m, &pose_a, &pose_b, (a.0.0, va, wa), (b.0.0, vb, wb));
-            let first = s.points.len() as u32;
+            let first = s.inputs.len() as u32;
             for p in &m.points {
                 let pa = Vec3A::from(pose_a * p.local_p1);
                 let pb = Vec3A::from(pose_b * p.local_p2);
@@ -414,20 +411,13 @@ fn prepare_contacts(
                 let (r_a, r_b) = (mid - a.0.0, mid - b.0.0);
                 let rel = (vb + wb.cross(r_b)) - (va + wa.cross(r_a));
                 let tangent = Vec3A::from(p.data.tangent);
-                s.points.push(PointConstraint {
+                s.inputs.push(PointInput {
                     r_a,
                     r_b,
                     base: p.dist - n.dot(r_b - r_a),
-                    normal: Axis::new(ma, &iia, r_a, mb, &iib, r_b, n),
-                    tangent: [
-                        Axis::new(ma, &iia, r_a, mb, &iib, r_b, t[0]),
-                        Axis::new(ma, &iia, r_a, mb, &iib, r_b, t[1]),
-                    ],
                     n_imp: p.data.normal,
                     t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
-                    max_n: 0.0,
                     approach: n.dot(rel),
-                    vn_seen: [f32::NAN; 2],
                 });
             }
             s.manifolds.push(ManifoldConstraint {
@@ -438,13 +428,13 @@ fn prepare_contacts(
                 friction,
                 restitution,
                 first,
-                count: s.points.len() as u32 - first,
+                count: s.inputs.len() as u32 - first,
                 pair: (ea, eb),
                 manifold: mi as u32,
-                fixed: ia == FIXED || ib == FIXED,
             });
         }
     }
+    s.build();
     active.0 = !s.manifolds.is_empty();
 }
 
@@ -459,39 +449,52 @@ type SolvedBody<'a> = (
 
 /// Reads the current state of every body in contact into the solver.
 fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
-    for b in &mut solver.bodies {
+    let mut frozen = Vec::new();
+    for (i, b) in solver.bodies.iter_mut().enumerate() {
         let Ok((x, q, v, l, inertia, w)) = bodies.get(b.entity) else {
             continue;
         };
-        b.dx = x.0 - b.x0;
-        b.dr = Mat3::from_quat(q.0 * b.q0.inverse());
-        b.v = v.0;
-        b.w = match (inertia, l) {
-            (Some(i), Some(l)) if !i.is_infinite() => i.angular_velocity(q.0, l.0),
+        let w = match (inertia, l) {
+            (Some(inertia), Some(l)) if !inertia.is_infinite() => {
+                inertia.angular_velocity(q.0, l.0)
+            }
             _ => w.map_or(Vec3A::ZERO, |w| w.0),
         };
-        b.ang = Vec3A::ZERO;
-        if !(b.v.is_finite() && b.w.is_finite() && b.dx.is_finite() && b.dr.is_finite()) {
+        let state = BodyState {
+            v: v.0,
+            w,
+            dx: x.0 - b.x0,
+            dr: Mat3::from_quat(q.0 * b.q0.inverse()),
+        };
+        b.w_in = w;
+        let finite =
+            state.v.is_finite() && w.is_finite() && state.dx.is_finite() && state.dr.is_finite();
+        if finite || !b.dynamic {
+            solver.states[i] = if finite { state } else { BodyState::REST };
+        } else {
             // A body that turned non-finite inside the step (it is quarantined at the next
             // position pass) must not pass NaN through its contacts: for the rest of the
             // step it is an immovable, motionless obstacle and is never written back.
-            b.dynamic = false;
-            b.inv_mass = 0.0;
-            (b.v, b.w, b.dx, b.dr) = (Vec3A::ZERO, Vec3A::ZERO, Vec3A::ZERO, Mat3::IDENTITY);
+            solver.states[i] = BodyState::REST;
+            frozen.push(i as u32);
         }
+    }
+    for i in frozen {
+        solver.freeze(i);
     }
 }
 
-/// Writes the solved velocities back: v directly, and L += Σ r × P (so ω = I⁻¹L follows).
+/// Writes the solved velocities back: v directly, and L += I₀ Δω, the angular impulse of
+/// the pass (the solver moved ω by I₀⁻¹ Σ r × P with the step's start inertia I₀).
 fn scatter(solver: &ContactSolver, bodies: &mut Query<SolvedBody, Live>) {
-    for b in &solver.bodies {
+    for (b, state) in solver.bodies.iter().zip(&solver.states) {
         if !b.dynamic {
             continue;
         }
-        if let Ok((_, _, mut v, l, ..)) = bodies.get_mut(b.entity) {
-            v.0 = b.v;
-            if let Some(mut l) = l {
-                l.bypass_change_detection().0 += b.ang;
+        if let Ok((_, _, mut v, l, inertia, _)) = bodies.get_mut(b.entity) {
+            v.0 = state.v;
+            if let (Some(mut l), Some(inertia)) = (l, inertia) {
+                l.bypass_change_detection().0 += inertia.angular_momentum(b.q0, state.w - b.w_in);
             }
         }
     }
@@ -535,18 +538,17 @@ fn relax_contacts(
     solver.solve(time.h, soft, fixed, false, settings.max_push_velocity);
     if time.is_last() {
         solver.restitution(settings.restitution_threshold);
-        for m in &solver.manifolds {
-            let Some(state) = contacts.pairs.get_mut(&m.pair) else {
-                continue;
-            };
-            let Some(manifold) = state.manifolds.get_mut(m.manifold as usize) else {
-                continue;
-            };
-            let points = &solver.points[m.first as usize..(m.first + m.count) as usize];
-            for (tracked, p) in manifold.points.iter_mut().zip(points) {
+        for (mi, k, normal, tangent) in solver.impulses() {
+            let m = &solver.manifolds[mi as usize];
+            let tracked = contacts
+                .pairs
+                .get_mut(&m.pair)
+                .and_then(|s| s.manifolds.get_mut(m.manifold as usize))
+                .and_then(|m| m.points.get_mut(k as usize));
+            if let Some(tracked) = tracked {
                 tracked.data = ContactImpulse {
-                    normal: p.n_imp,
-                    tangent: (p.t_imp[0] * m.t[0] + p.t_imp[1] * m.t[1]).into(),
+                    normal,
+                    tangent: tangent.into(),
                 };
             }
         }

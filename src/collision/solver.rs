@@ -1,4 +1,5 @@
-//! The soft-step contact solver (after Box2D v3, extended to 3D friction).
+//! The soft-step contact solver (after Box2D v3, extended to 3D friction), four manifolds
+//! at a time.
 //!
 //! Per contact point, with normal n from a to b, lever arms r_a, r_b from the centres of
 //! mass and relative normal velocity v_n:
@@ -13,82 +14,68 @@
 //! ω = 2πf: a₁ = 2ζ + hω, a₂ = hω a₁, β = ω/a₁, S_m = a₂/(1 + a₂), S_i = 1/(1 + a₂). The
 //! accumulated normal impulse stays ≥ 0; friction clamps the tangent impulse vector to
 //! μ λ_n.
+//!
+//! **Batches.** The manifolds are coloured so that no dynamic body appears twice in a colour
+//! (static and kinematic bodies take no impulse, so they may), and each colour is cut into
+//! batches of four that are solved together in SIMD lanes: the four manifolds of a batch
+//! touch four different bodies on each side, so solving them at once gives exactly what
+//! solving them one after another would. Manifolds that find no colour are solved one per
+//! batch, after the colours. The order is fixed by the order of the manifolds, so results
+//! are bit-identical from run to run.
 
 use std::collections::HashMap;
 
 use bevy_ecs::prelude::*;
 use glam::{Mat3, Quat, Vec3A};
 
+use super::lanes::{F4, M3, V3};
+
 /// Index of the immovable "body" that stands for every static collider.
 pub(crate) const FIXED: u32 = u32::MAX;
 
+/// Colours tried before a manifold goes to the one-per-batch overflow.
+const COLOURS: usize = 12;
+
+/// What a body brings to the step's contacts: set once per step.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct SolverBody {
     pub entity: Entity,
+    /// Zero for kinematic bodies: they drive contacts but are never pushed.
     pub inv_mass: f32,
-    /// World inverse inertia at the start of the step.
+    /// World inverse inertia at the start of the step (zero for kinematic bodies).
     pub inv_i: Mat3,
     /// Centre of mass and rotation at the start of the step.
     pub x0: Vec3A,
     pub q0: Quat,
-    /// Displacement and rotation (as a matrix) since the start of the step.
-    pub dx: Vec3A,
-    pub dr: Mat3,
-    pub v: Vec3A,
-    pub w: Vec3A,
-    /// Σ r × P applied during the current pass: added to L on scatter.
-    pub ang: Vec3A,
-    /// False for kinematic bodies: they drive contacts but are never pushed.
+    /// Angular velocity when the current pass began: the pass's change of ω, times the
+    /// inertia, is the angular impulse it applied.
+    pub w_in: Vec3A,
+    /// False for kinematic bodies and for bodies frozen out of the step.
     pub dynamic: bool,
 }
 
-/// One direction (normal or tangent) of a contact point, with everything the solver needs
-/// precomputed: the lever products r × d and their images I⁻¹(r × d), and the effective mass.
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct Axis {
-    pub rd_a: Vec3A,
-    pub rd_b: Vec3A,
-    pub ird_a: Vec3A,
-    pub ird_b: Vec3A,
-    pub mass: f32,
+/// The velocity state of one body during a pass.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct BodyState {
+    pub v: Vec3A,
+    pub w: Vec3A,
+    /// Displacement and rotation (as a matrix) since the start of the step.
+    pub dx: Vec3A,
+    pub dr: Mat3,
 }
 
-impl Axis {
-    pub fn new(ma: f32, ia: &Mat3, ra: Vec3A, mb: f32, ib: &Mat3, rb: Vec3A, d: Vec3A) -> Self {
-        let (rd_a, rd_b) = (ra.cross(d), rb.cross(d));
-        let ird_a = Vec3A::from(*ia * glam::Vec3::from(rd_a));
-        let ird_b = Vec3A::from(*ib * glam::Vec3::from(rd_b));
-        let k = ma + mb + rd_a.dot(ird_a) + rd_b.dot(ird_b);
-        Self {
-            rd_a,
-            rd_b,
-            ird_a,
-            ird_b,
-            mass: if k > 0.0 { 1.0 / k } else { 0.0 },
-        }
-    }
+impl BodyState {
+    /// A body that does not move: every static collider reads this.
+    pub const REST: Self = Self {
+        v: Vec3A::ZERO,
+        w: Vec3A::ZERO,
+        dx: Vec3A::ZERO,
+        dr: Mat3::IDENTITY,
+    };
 }
 
-#[derive(Debug, Clone, Copy, Default)]
-pub(crate) struct PointConstraint {
-    pub r_a: Vec3A,
-    pub r_b: Vec3A,
-    /// Separation minus n·(r_b − r_a) at the start: the current separation is
-    /// n·(Δx_b + ΔR_b r_b − Δx_a − ΔR_a r_a) + base.
-    pub base: f32,
-    pub normal: Axis,
-    pub tangent: [Axis; 2],
-    pub n_imp: f32,
-    pub t_imp: [f32; 2],
-    pub max_n: f32,
-    /// Relative normal velocity at the start of the step (negative when approaching), then
-    /// the speed of impact once the contact first pushes.
-    pub approach: f32,
-    /// Normal velocity seen by the last two biased passes (one substep apart): their
-    /// difference is the approach acceleration, used to extrapolate the speed of impact.
-    pub vn_seen: [f32; 2],
-}
-
+/// One manifold as the narrow phase gave it; its points are `first..first + count` of
+/// [`ContactSolver::inputs`].
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct ManifoldConstraint {
     pub a: u32,
@@ -101,17 +88,108 @@ pub(crate) struct ManifoldConstraint {
     pub count: u32,
     pub pair: (Entity, Entity),
     pub manifold: u32,
-    /// One side is fixed: use the stiffer static softness.
-    pub fixed: bool,
+}
+
+/// One contact point as the narrow phase gave it.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct PointInput {
+    pub r_a: Vec3A,
+    pub r_b: Vec3A,
+    /// Separation minus n·(r_b − r_a) at the start: the current separation is
+    /// n·(Δx_b + ΔR_b r_b − Δx_a − ΔR_a r_a) + base.
+    pub base: f32,
+    /// Warm-start impulses: normal, and along the manifold's two tangents.
+    pub n_imp: f32,
+    pub t_imp: [f32; 2],
+    /// Relative normal velocity at the start of the step (negative when approaching).
+    pub approach: f32,
+}
+
+/// One direction (normal or tangent) of four contact points, with everything the solver
+/// needs precomputed: the lever products r × d, their images I⁻¹(r × d), the effective mass.
+#[derive(Debug, Clone, Copy, Default)]
+struct Axis {
+    rd_a: V3,
+    rd_b: V3,
+    ird_a: V3,
+    ird_b: V3,
+    mass: F4,
+}
+
+impl Axis {
+    /// `live` is all-ones for lanes that hold a point, zero for padding (mass 0: no impulse).
+    #[inline]
+    #[allow(clippy::too_many_arguments)] // the two sides of one formula
+    fn new(ma: F4, ia: &M3, ra: V3, mb: F4, ib: &M3, rb: V3, d: V3, live: F4) -> Self {
+        let (rd_a, rd_b) = (ra.cross(d), rb.cross(d));
+        let (ird_a, ird_b) = (ia.mul_vec(rd_a), ib.mul_vec(rd_b));
+        let k = ma + mb + rd_a.dot(ird_a) + rd_b.dot(ird_b);
+        let usable = k.simd_gt(F4::ZERO) & live;
+        Self {
+            rd_a,
+            rd_b,
+            ird_a,
+            ird_b,
+            mass: usable.select(F4::ONE / k, F4::ZERO),
+        }
+    }
+}
+
+/// Four contact points, the k-th of each manifold of a batch.
+#[derive(Debug, Clone, Copy, Default)]
+struct Point {
+    r_a: V3,
+    r_b: V3,
+    base: F4,
+    normal: Axis,
+    tangent: [Axis; 2],
+    n_imp: F4,
+    t_imp: [F4; 2],
+    /// Largest normal impulse of one pass this step (zero: the point never pushed).
+    max_n: F4,
+    /// Relative normal velocity at the start of the step, then the speed of impact once the
+    /// contact first pushes.
+    approach: F4,
+    /// Normal velocity seen by the last two biased passes (one substep apart): their
+    /// difference is the approach acceleration, used to extrapolate the speed of impact.
+    vn_seen: [F4; 2],
+}
+
+/// Up to four manifolds with no dynamic body in common, solved together.
+#[derive(Debug, Clone, Copy)]
+struct Batch {
+    /// Manifold per lane (`u32::MAX` for an empty lane).
+    lanes: [u32; 4],
+    /// Body state indices per lane; the rest state for static sides and empty lanes.
+    a: [u32; 4],
+    b: [u32; 4],
+    /// Points `first..first + count` of [`ContactSolver::points`].
+    first: u32,
+    count: u32,
+    n: V3,
+    t: [V3; 2],
+    inv_m_a: F4,
+    inv_m_b: F4,
+    friction: F4,
+    restitution: F4,
+    /// All-ones in lanes where one side is static: they use the stiffer static softness.
+    fixed: F4,
 }
 
 /// The step's contact constraints and the bodies they touch.
 #[derive(Resource, Default)]
 pub(crate) struct ContactSolver {
     pub bodies: Vec<SolverBody>,
+    /// Per body, then one [`BodyState::REST`] for every static side and empty lane.
+    pub states: Vec<BodyState>,
     pub manifolds: Vec<ManifoldConstraint>,
-    pub points: Vec<PointConstraint>,
+    pub inputs: Vec<PointInput>,
     pub index: HashMap<Entity, u32>,
+    batches: Vec<Batch>,
+    points: Vec<Point>,
+    /// Colouring scratch, kept to reuse its memory.
+    colours: Vec<Vec<u32>>,
+    used: Vec<u64>,
 }
 
 /// The soft-constraint coefficients for frequency `hertz`, damping ratio `zeta` and step `h`.
@@ -150,103 +228,279 @@ impl Softness {
 /// biased passes (one substep apart), the speed it would have hit with is √(vn² + 2|a|s).
 /// Restitution bounces from that speed (without it a ball dropped 1 m with e = 0.8 rose
 /// 0.617 m instead of 0.64 at 4 substeps).
-fn impact_speed(vn: f32, s: f32, seen: [f32; 2], inv_h: f32) -> f32 {
+#[inline]
+fn impact_speed(vn: F4, s: F4, seen: [F4; 2], inv_h: F4) -> F4 {
     let a = (seen[1] - seen[0]) * inv_h;
-    if s > 0.0 && vn < 0.0 && a < 0.0 && a.is_finite() {
-        -(vn * vn - 2.0 * a * s).sqrt()
-    } else {
-        vn
-    }
+    // A NaN (no second pass yet) fails every comparison, so it never extrapolates.
+    let extrapolate = s.simd_gt(F4::ZERO)
+        & vn.simd_lt(F4::ZERO)
+        & a.simd_lt(F4::ZERO)
+        & a.simd_gt(F4::splat(f32::MIN));
+    extrapolate.select(-(vn * vn - (a + a) * s).sqrt(), vn)
 }
 
-/// The velocity state of one side of a manifold during a pass (a fixed side is all zeros).
+/// One side of four manifolds during a pass.
 #[derive(Clone, Copy)]
 struct Side {
-    v: Vec3A,
-    w: Vec3A,
-    ang: Vec3A,
-    inv_m: f32,
-    dx: Vec3A,
-    dr: Mat3,
+    v: V3,
+    w: V3,
+    inv_m: F4,
 }
 
-const FIXED_SIDE: Side = Side {
-    v: Vec3A::ZERO,
-    w: Vec3A::ZERO,
-    ang: Vec3A::ZERO,
-    inv_m: 0.0,
-    dx: Vec3A::ZERO,
-    dr: Mat3::IDENTITY,
-};
-
 impl Side {
-    /// Relative velocity of b against a along `axis` at the point.
+    /// Relative velocity of b against a along `d` at the points.
     #[inline]
-    fn along(a: &Side, b: &Side, d: Vec3A, axis: &Axis) -> f32 {
+    fn along(a: &Side, b: &Side, d: V3, axis: &Axis) -> F4 {
         d.dot(b.v - a.v) + b.w.dot(axis.rd_b) - a.w.dot(axis.rd_a)
     }
 
     /// Applies impulse λ along `d`: −λ to a, +λ to b.
     #[inline]
-    fn push(a: &mut Side, b: &mut Side, d: Vec3A, axis: &Axis, lambda: f32) {
+    fn push(a: &mut Side, b: &mut Side, d: V3, axis: &Axis, lambda: F4) {
         a.v -= (a.inv_m * lambda) * d;
         a.w -= lambda * axis.ird_a;
-        a.ang -= lambda * axis.rd_a;
         b.v += (b.inv_m * lambda) * d;
         b.w += lambda * axis.ird_b;
-        b.ang += lambda * axis.rd_b;
     }
 }
 
 impl ContactSolver {
+    /// Empties the solver for a new step.
+    pub fn clear(&mut self) {
+        self.bodies.clear();
+        self.states.clear();
+        self.manifolds.clear();
+        self.inputs.clear();
+        self.index.clear();
+        self.batches.clear();
+        self.points.clear();
+    }
+
+    /// Index of the rest state (static sides, empty lanes).
     #[inline]
-    fn side(&self, i: u32) -> Side {
-        match self.bodies.get(i as usize) {
-            Some(b) if b.dynamic => Side {
-                v: b.v,
-                w: b.w,
-                ang: b.ang,
-                inv_m: b.inv_mass,
-                dx: b.dx,
-                dr: b.dr,
-            },
-            // A kinematic body moves its side of the contact but takes no impulse: its
-            // precomputed inverse-inertia terms are zero and so is its inverse mass here.
-            Some(b) => Side {
-                v: b.v,
-                w: b.w,
-                ang: Vec3A::ZERO,
-                inv_m: 0.0,
-                dx: b.dx,
-                dr: b.dr,
-            },
-            None => FIXED_SIDE,
+    fn rest(&self) -> u32 {
+        self.bodies.len() as u32
+    }
+
+    /// Colours the manifolds and lays them out in batches, with their effective masses.
+    /// Call once per step after every body and manifold was added.
+    pub fn build(&mut self) {
+        self.build_with(COLOURS);
+    }
+
+    /// [`Self::build`] with at most `max_colours` colours (0: every manifold alone).
+    fn build_with(&mut self, max_colours: usize) {
+        self.states.clear();
+        self.states.resize(self.bodies.len() + 1, BodyState::REST);
+        let words = self.bodies.len().div_ceil(64);
+        self.used.clear();
+        self.used.resize(words * max_colours, 0);
+        self.colours.resize_with(max_colours, Vec::new);
+        for c in &mut self.colours {
+            c.clear();
+        }
+        let mut overflow = Vec::new();
+        let (bodies, used) = (&self.bodies, &mut self.used);
+        let movable = |i: u32| {
+            bodies
+                .get(i as usize)
+                .filter(|b| b.dynamic)
+                .map(|_| i as usize)
+        };
+        for (mi, m) in self.manifolds.iter().enumerate() {
+            let sides = [movable(m.a), movable(m.b)];
+            let free = |used: &[u64], c: usize| {
+                sides
+                    .iter()
+                    .flatten()
+                    .all(|&i| used[c * words + i / 64] & (1 << (i % 64)) == 0)
+            };
+            match (0..max_colours).find(|&c| free(used, c)) {
+                Some(c) => {
+                    for &i in sides.iter().flatten() {
+                        used[c * words + i / 64] |= 1 << (i % 64);
+                    }
+                    self.colours[c].push(mi as u32);
+                }
+                None => overflow.push(mi as u32),
+            }
+        }
+        let colours = std::mem::take(&mut self.colours);
+        for c in &colours {
+            for chunk in c.chunks(4) {
+                self.push_batch(chunk);
+            }
+        }
+        for &mi in &overflow {
+            self.push_batch(&[mi]);
+        }
+        self.colours = colours;
+    }
+
+    fn push_batch(&mut self, chunk: &[u32]) {
+        let rest = self.rest();
+        let lane = |l: usize| chunk.get(l).map(|&mi| &self.manifolds[mi as usize]);
+        let side = |l: usize, pick: fn(&ManifoldConstraint) -> u32| {
+            lane(l).map_or(rest, |m| pick(m).min(rest))
+        };
+        let a: [u32; 4] = std::array::from_fn(|l| side(l, |m| m.a));
+        let b: [u32; 4] = std::array::from_fn(|l| side(l, |m| m.b));
+        let scalar = |f: fn(&ManifoldConstraint) -> f32| {
+            F4::new(std::array::from_fn(|l| lane(l).map_or(0.0, f)))
+        };
+        let vector = |f: fn(&ManifoldConstraint) -> Vec3A| {
+            V3::from_lanes(std::array::from_fn(|l| lane(l).map_or(Vec3A::ZERO, f)))
+        };
+        let count = chunk
+            .iter()
+            .map(|&mi| self.manifolds[mi as usize].count)
+            .max()
+            .unwrap_or(0);
+        let fixed = std::array::from_fn(|l| lane(l).is_some_and(|m| m.a == FIXED || m.b == FIXED));
+        let batch = Batch {
+            lanes: std::array::from_fn(|l| chunk.get(l).copied().unwrap_or(u32::MAX)),
+            a,
+            b,
+            first: self.points.len() as u32,
+            count,
+            n: vector(|m| m.n),
+            t: [vector(|m| m.t[0]), vector(|m| m.t[1])],
+            // Set with the axes.
+            inv_m_a: F4::ZERO,
+            inv_m_b: F4::ZERO,
+            friction: scalar(|m| m.friction),
+            restitution: scalar(|m| m.restitution),
+            fixed: F4::new(fixed.map(|f| if f { f32::from_bits(!0) } else { 0.0 })),
+        };
+        for k in 0..count {
+            let input = |l: usize| {
+                lane(l)
+                    .filter(|m| k < m.count)
+                    .map(|m| self.inputs[(m.first + k) as usize])
+            };
+            let p: [Option<PointInput>; 4] = std::array::from_fn(input);
+            let get = |f: fn(&PointInput) -> f32| F4::new(p.map(|p| p.as_ref().map_or(0.0, f)));
+            self.points.push(Point {
+                r_a: V3::from_lanes(p.map(|p| p.map_or(Vec3A::ZERO, |p| p.r_a))),
+                r_b: V3::from_lanes(p.map(|p| p.map_or(Vec3A::ZERO, |p| p.r_b))),
+                base: get(|p| p.base),
+                normal: Axis::default(),
+                tangent: [Axis::default(); 2],
+                n_imp: get(|p| p.n_imp),
+                t_imp: [get(|p| p.t_imp[0]), get(|p| p.t_imp[1])],
+                max_n: F4::ZERO,
+                approach: get(|p| p.approach),
+                vn_seen: [F4::splat(f32::NAN); 2],
+            });
+        }
+        self.batches.push(batch);
+        self.compute_axes(self.batches.len() - 1);
+    }
+
+    /// The effective masses and lever terms of every point of batch `bi`, from its bodies'
+    /// current inverse masses and inertias.
+    fn compute_axes(&mut self, bi: usize) {
+        const ZERO: Mat3 = Mat3::ZERO;
+        let batch = self.batches[bi];
+        let body = |i: u32| self.bodies.get(i as usize);
+        let inv_m = |ix: [u32; 4]| F4::new(ix.map(|i| body(i).map_or(0.0, |b| b.inv_mass)));
+        let inv_i = |ix: [u32; 4]| M3::from_lanes(ix.map(|i| body(i).map_or(&ZERO, |b| &b.inv_i)));
+        let (ma, mb, ia, ib) = (
+            inv_m(batch.a),
+            inv_m(batch.b),
+            inv_i(batch.a),
+            inv_i(batch.b),
+        );
+        let counts = batch
+            .lanes
+            .map(|mi| self.manifolds.get(mi as usize).map_or(0, |m| m.count));
+        let range = batch.first as usize..(batch.first + batch.count) as usize;
+        for (k, p) in self.points[range].iter_mut().enumerate() {
+            let live = F4::new(counts.map(|c| {
+                if (k as u32) < c {
+                    f32::from_bits(!0)
+                } else {
+                    0.0
+                }
+            }));
+            let axis = |d: V3| Axis::new(ma, &ia, p.r_a, mb, &ib, p.r_b, d, live);
+            p.normal = axis(batch.n);
+            p.tangent = [axis(batch.t[0]), axis(batch.t[1])];
+        }
+        let batch = &mut self.batches[bi];
+        (batch.inv_m_a, batch.inv_m_b) = (ma, mb);
+    }
+
+    /// Takes `body` out of the rest of the step: it turned non-finite, and from now on every
+    /// contact sees it as an immovable, motionless obstacle.
+    pub fn freeze(&mut self, body: u32) {
+        let rest = self.rest();
+        if let Some(b) = self.bodies.get_mut(body as usize) {
+            b.dynamic = false;
+        }
+        for bi in 0..self.batches.len() {
+            let batch = &mut self.batches[bi];
+            let mut touched = false;
+            for i in batch.a.iter_mut().chain(batch.b.iter_mut()) {
+                if *i == body {
+                    *i = rest;
+                    touched = true;
+                }
+            }
+            if touched {
+                self.compute_axes(bi);
+            }
         }
     }
 
     #[inline]
-    fn store(&mut self, i: u32, s: &Side) {
-        if let Some(b) = self.bodies.get_mut(i as usize)
-            && b.dynamic
-        {
-            b.v = s.v;
-            b.w = s.w;
-            b.ang = s.ang;
+    fn load(&self, ix: [u32; 4], inv_m: F4) -> Side {
+        let s = ix.map(|i| &self.states[i as usize]);
+        Side {
+            v: V3::from_lanes(s.map(|s| s.v)),
+            w: V3::from_lanes(s.map(|s| s.w)),
+            inv_m,
         }
+    }
+
+    #[inline]
+    fn store(&mut self, ix: [u32; 4], side: &Side) {
+        let rest = self.rest();
+        let (v, w) = (side.v.lanes(), side.w.lanes());
+        for l in 0..4 {
+            if ix[l] != rest {
+                let s = &mut self.states[ix[l] as usize];
+                s.v = v[l];
+                s.w = w[l];
+            }
+        }
+    }
+
+    /// Δx and ΔR of both sides, for the current separations.
+    #[inline]
+    fn motion(&self, ix: [u32; 4]) -> (V3, M3) {
+        let s = ix.map(|i| &self.states[i as usize]);
+        (
+            V3::from_lanes(s.map(|s| s.dx)),
+            M3::from_lanes(s.map(|s| &s.dr)),
+        )
     }
 
     /// Applies every accumulated impulse once (warm start).
     pub fn warm_start(&mut self) {
-        for mi in 0..self.manifolds.len() {
-            let m = self.manifolds[mi];
-            let (mut a, mut b) = (self.side(m.a), self.side(m.b));
-            for p in &self.points[m.first as usize..(m.first + m.count) as usize] {
-                Side::push(&mut a, &mut b, m.n, &p.normal, p.n_imp);
-                Side::push(&mut a, &mut b, m.t[0], &p.tangent[0], p.t_imp[0]);
-                Side::push(&mut a, &mut b, m.t[1], &p.tangent[1], p.t_imp[1]);
+        for bi in 0..self.batches.len() {
+            let batch = self.batches[bi];
+            let (mut a, mut b) = (
+                self.load(batch.a, batch.inv_m_a),
+                self.load(batch.b, batch.inv_m_b),
+            );
+            for p in &self.points[batch.first as usize..(batch.first + batch.count) as usize] {
+                Side::push(&mut a, &mut b, batch.n, &p.normal, p.n_imp);
+                Side::push(&mut a, &mut b, batch.t[0], &p.tangent[0], p.t_imp[0]);
+                Side::push(&mut a, &mut b, batch.t[1], &p.tangent[1], p.t_imp[1]);
             }
-            self.store(m.a, &a);
-            self.store(m.b, &b);
+            self.store(batch.a, &a);
+            self.store(batch.b, &b);
         }
     }
 
@@ -263,136 +517,146 @@ impl ContactSolver {
         use_bias: bool,
         max_push: f32,
     ) {
-        let inv_h = 1.0 / h;
-        for mi in 0..self.manifolds.len() {
-            let m = self.manifolds[mi];
-            let (mut a, mut b) = (self.side(m.a), self.side(m.b));
-            let soft = if m.fixed { fixed_soft } else { soft };
-            let range = m.first as usize..(m.first + m.count) as usize;
+        let inv_h = F4::splat(1.0 / h);
+        let max_push = F4::splat(-max_push);
+        let (zero, one) = (F4::ZERO, F4::ONE);
+        for bi in 0..self.batches.len() {
+            let batch = self.batches[bi];
+            let (mut a, mut b) = (
+                self.load(batch.a, batch.inv_m_a),
+                self.load(batch.b, batch.inv_m_b),
+            );
+            let (dx_a, dr_a) = self.motion(batch.a);
+            let (dx_b, dr_b) = self.motion(batch.b);
+            let pick = |f: fn(&Softness) -> f32| {
+                batch
+                    .fixed
+                    .select(F4::splat(f(&fixed_soft)), F4::splat(f(&soft)))
+            };
+            let (bias_rate, mass_scale, impulse_scale) = if use_bias {
+                (
+                    pick(|s| s.bias_rate),
+                    pick(|s| s.mass_scale),
+                    pick(|s| s.impulse_scale),
+                )
+            } else {
+                (zero, one, zero)
+            };
+            let range = batch.first as usize..(batch.first + batch.count) as usize;
             if use_bias {
-                Self::friction(&m, &mut self.points[range.clone()], &mut a, &mut b);
+                Self::friction(&batch, &mut self.points[range.clone()], &mut a, &mut b);
             }
             for p in &mut self.points[range.clone()] {
-                let d = (b.dx - a.dx)
-                    + Vec3A::from(b.dr * glam::Vec3::from(p.r_b) - a.dr * glam::Vec3::from(p.r_a));
-                let s = m.n.dot(d) + p.base;
-                let (bias, mass_scale, impulse_scale) = if s > 0.0 {
-                    (s * inv_h, 1.0, 0.0)
-                } else if use_bias {
-                    (
-                        (soft.bias_rate * s).max(-max_push),
-                        soft.mass_scale,
-                        soft.impulse_scale,
-                    )
-                } else {
-                    (0.0, 1.0, 0.0)
-                };
-                let vn = Side::along(&a, &b, m.n, &p.normal);
+                let d = (dx_b - dx_a) + (dr_b.mul_vec(p.r_b) - dr_a.mul_vec(p.r_a));
+                let s = batch.n.dot(d) + p.base;
+                let speculative = s.simd_gt(zero);
+                let bias = speculative.select(s * inv_h, (bias_rate * s).fast_max(max_push));
+                let m_scale = speculative.select(one, mass_scale);
+                let i_scale = speculative.select(zero, impulse_scale);
+                let vn = Side::along(&a, &b, batch.n, &p.normal);
                 if use_bias {
                     p.vn_seen = [p.vn_seen[1], vn];
                 }
-                let imp = -p.normal.mass * mass_scale * (vn + bias) - impulse_scale * p.n_imp;
-                let total = (p.n_imp + imp).max(0.0);
+                let imp = -p.normal.mass * m_scale * (vn + bias) - i_scale * p.n_imp;
+                let total = (p.n_imp + imp).fast_max(zero);
                 let imp = total - p.n_imp;
-                if p.max_n == 0.0 && imp > 0.0 {
-                    p.approach = p.approach.min(impact_speed(vn, s, p.vn_seen, inv_h));
+                let first = p.max_n.simd_eq(zero) & imp.simd_gt(zero);
+                if first.any() {
+                    let hit = impact_speed(vn, s, p.vn_seen, inv_h);
+                    p.approach = first.select(p.approach.fast_min(hit), p.approach);
                 }
                 p.n_imp = total;
-                p.max_n = p.max_n.max(imp);
-                Side::push(&mut a, &mut b, m.n, &p.normal, imp);
+                p.max_n = p.max_n.fast_max(imp);
+                Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
             }
             if !use_bias {
-                Self::friction(&m, &mut self.points[range], &mut a, &mut b);
+                Self::friction(&batch, &mut self.points[range], &mut a, &mut b);
             }
-            self.store(m.a, &a);
-            self.store(m.b, &b);
+            self.store(batch.a, &a);
+            self.store(batch.b, &b);
         }
     }
 
-    /// Coulomb friction for one manifold: the tangent impulse vector clamped to μ λ_n.
+    /// Coulomb friction for four manifolds: each tangent impulse vector clamped to μ λ_n.
     #[inline]
-    fn friction(
-        m: &ManifoldConstraint,
-        points: &mut [PointConstraint],
-        a: &mut Side,
-        b: &mut Side,
-    ) {
+    fn friction(batch: &Batch, points: &mut [Point], a: &mut Side, b: &mut Side) {
         for p in points {
             let old = p.t_imp;
-            let mut new = [
-                old[0] - p.tangent[0].mass * Side::along(a, b, m.t[0], &p.tangent[0]),
-                old[1] - p.tangent[1].mass * Side::along(a, b, m.t[1], &p.tangent[1]),
+            let new = [
+                old[0] - p.tangent[0].mass * Side::along(a, b, batch.t[0], &p.tangent[0]),
+                old[1] - p.tangent[1].mass * Side::along(a, b, batch.t[1], &p.tangent[1]),
             ];
-            let limit = m.friction * p.n_imp;
+            let limit = batch.friction * p.n_imp;
             let len2 = new[0] * new[0] + new[1] * new[1];
-            if len2 > limit * limit && len2 > 0.0 {
-                let s = limit / len2.sqrt();
-                new = [new[0] * s, new[1] * s];
-            }
+            let clamp = len2.simd_gt(limit * limit);
+            let scale = clamp.select(limit / len2.sqrt(), F4::ONE);
+            let new = [new[0] * scale, new[1] * scale];
             p.t_imp = new;
-            Side::push(a, b, m.t[0], &p.tangent[0], new[0] - old[0]);
-            Side::push(a, b, m.t[1], &p.tangent[1], new[1] - old[1]);
+            Side::push(a, b, batch.t[0], &p.tangent[0], new[0] - old[0]);
+            Side::push(a, b, batch.t[1], &p.tangent[1], new[1] - old[1]);
         }
     }
 
     /// After the last substep: contacts that hit faster than `threshold` leave at −e times
     /// their approach speed.
     pub fn restitution(&mut self, threshold: f32) {
-        for mi in 0..self.manifolds.len() {
-            let m = self.manifolds[mi];
-            if m.restitution == 0.0 {
+        let zero = F4::ZERO;
+        let threshold = F4::splat(-threshold);
+        for bi in 0..self.batches.len() {
+            let batch = self.batches[bi];
+            let bouncy = batch.restitution.simd_gt(zero);
+            if !bouncy.any() {
                 continue;
             }
-            let (mut a, mut b) = (self.side(m.a), self.side(m.b));
-            for p in &mut self.points[m.first as usize..(m.first + m.count) as usize] {
-                if p.approach > -threshold || p.max_n == 0.0 {
+            let (mut a, mut b) = (
+                self.load(batch.a, batch.inv_m_a),
+                self.load(batch.b, batch.inv_m_b),
+            );
+            for p in &mut self.points[batch.first as usize..(batch.first + batch.count) as usize] {
+                let hit = bouncy & p.approach.simd_lt(threshold) & p.max_n.simd_gt(zero);
+                if !hit.any() {
                     continue;
                 }
-                let vn = Side::along(&a, &b, m.n, &p.normal);
-                let imp = -p.normal.mass * (vn + m.restitution * p.approach);
-                let total = (p.n_imp + imp).max(0.0);
+                let vn = Side::along(&a, &b, batch.n, &p.normal);
+                let imp = -p.normal.mass * (vn + batch.restitution * p.approach);
+                let total = hit.select((p.n_imp + imp).fast_max(zero), p.n_imp);
                 let imp = total - p.n_imp;
                 p.n_imp = total;
-                Side::push(&mut a, &mut b, m.n, &p.normal, imp);
+                Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
             }
-            self.store(m.a, &a);
-            self.store(m.b, &b);
+            self.store(batch.a, &a);
+            self.store(batch.b, &b);
         }
+    }
+
+    /// The accumulated impulses of every point, for the next step's warm start: manifold
+    /// index, point index within it, normal impulse and tangent impulse vector.
+    pub fn impulses(&self) -> impl Iterator<Item = (u32, u32, f32, Vec3A)> + '_ {
+        self.batches.iter().flat_map(move |batch| {
+            let points = &self.points[batch.first as usize..(batch.first + batch.count) as usize];
+            (0..4)
+                .filter_map(move |l| {
+                    let mi = batch.lanes[l];
+                    self.manifolds.get(mi as usize).map(|m| (l, mi, m))
+                })
+                .flat_map(move |(l, mi, m)| {
+                    points
+                        .iter()
+                        .take(m.count as usize)
+                        .enumerate()
+                        .map(move |(k, p)| {
+                            let t = [p.t_imp[0].to_array()[l], p.t_imp[1].to_array()[l]];
+                            (
+                                mi,
+                                k as u32,
+                                p.n_imp.to_array()[l],
+                                t[0] * m.t[0] + t[1] * m.t[1],
+                            )
+                        })
+                })
+        })
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn softness_matches_box2d_coefficients() {
-        // f = 30 Hz, ζ = 10, h = 1/240: ω = 188.5, a1 = 20.785, a2 = 16.32.
-        let s = Softness::new(30.0, 10.0, 1.0 / 240.0);
-        let omega = std::f32::consts::TAU * 30.0;
-        let a1 = 20.0 + omega / 240.0;
-        let a2 = omega / 240.0 * a1;
-        assert!((s.bias_rate - omega / a1).abs() < 1e-4);
-        assert!((s.mass_scale - a2 / (1.0 + a2)).abs() < 1e-6);
-        assert!((s.impulse_scale - 1.0 / (1.0 + a2)).abs() < 1e-6);
-        assert_eq!(Softness::new(0.0, 1.0, 0.01).mass_scale, 1.0);
-    }
-
-    #[test]
-    fn effective_mass_of_a_point_mass_and_a_lever() {
-        let z = Mat3::ZERO;
-        assert_eq!(
-            Axis::new(0.5, &z, Vec3A::ZERO, 0.0, &z, Vec3A::ZERO, Vec3A::Y).mass,
-            2.0
-        );
-        // A unit-inertia body hit at r = x along y: k = 1/m + |r × n|² / I = 1 + 1.
-        let i = Mat3::IDENTITY;
-        assert!(
-            (Axis::new(1.0, &i, Vec3A::X, 0.0, &z, Vec3A::ZERO, Vec3A::Y).mass - 0.5).abs() < 1e-6
-        );
-        assert_eq!(
-            Axis::new(0.0, &z, Vec3A::X, 0.0, &z, Vec3A::X, Vec3A::Y).mass,
-            0.0
-        );
-    }
-}
+mod tests;
