@@ -16,7 +16,7 @@
 //! Particles, meshes and bodies attached to springs never sleep: springs act only between
 //! awake bodies, and a spring's pull is not a contact that the islands could see.
 
-use std::collections::HashMap;
+use bevy_platform::collections::HashMap;
 
 use bevy_ecs::prelude::*;
 

@@ -1,6 +1,6 @@
 //! Narrow phase: persistent contact manifolds per pair, and the contact query API.
 
-use std::collections::HashMap;
+use bevy_platform::collections::HashMap;
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;

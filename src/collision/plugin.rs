@@ -308,15 +308,19 @@ fn body_index(
     // A kinematic body drives its contacts but takes no impulse: zero inverse mass and
     // inertia make every push on it exactly nothing.
     let dynamic = !mass.is_pinned();
-    let inv_i = match inertia {
-        Some(i) if dynamic => i.world_inverse_tensor(q.0),
-        _ => Mat3::ZERO,
+    let (inv_i, i0) = match inertia {
+        Some(i) if dynamic && !i.is_infinite() => {
+            let r = Mat3::from_quat(q.0);
+            (i.world_inverse_tensor(q.0), r * i.tensor() * r.transpose())
+        }
+        _ => (Mat3::ZERO, Mat3::ZERO),
     };
     let i = solver.bodies.len() as u32;
     solver.bodies.push(SolverBody {
         entity: e,
         inv_mass: if dynamic { mass.inverse() } else { 0.0 },
         inv_i,
+        i0,
         x0: x.0,
         q0: q.0,
         w_in: w.map_or(Vec3A::ZERO, |w| w.0),
@@ -443,7 +447,6 @@ type SolvedBody<'a> = (
     &'a Rotation,
     &'a mut LinearVelocity,
     Option<&'a mut AngularMomentum>,
-    Option<&'a Inertia>,
     Option<&'a AngularVelocity>,
 );
 
@@ -451,12 +454,16 @@ type SolvedBody<'a> = (
 fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
     let mut frozen = Vec::new();
     for (i, b) in solver.bodies.iter_mut().enumerate() {
-        let Ok((x, q, v, l, inertia, w)) = bodies.get(b.entity) else {
+        let Ok((x, q, v, l, w)) = bodies.get(b.entity) else {
             continue;
         };
-        let w = match (inertia, l) {
-            (Some(inertia), Some(l)) if !inertia.is_infinite() => {
-                inertia.angular_velocity(q.0, l.0)
+        let dr = Mat3::from_quat(q.0 * b.q0.inverse());
+        // ω = I(q)⁻¹ L, with I(q)⁻¹ = ΔR I₀⁻¹ ΔRᵀ: three matrix products instead of the
+        // quaternion round trip through the principal frame.
+        let w = match l {
+            Some(l) if b.dynamic => {
+                let l = glam::Vec3::from(l.0);
+                Vec3A::from(dr * (b.inv_i * (dr.transpose() * l)))
             }
             _ => w.map_or(Vec3A::ZERO, |w| w.0),
         };
@@ -464,11 +471,10 @@ fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
             v: v.0,
             w,
             dx: x.0 - b.x0,
-            dr: Mat3::from_quat(q.0 * b.q0.inverse()),
+            dr,
         };
         b.w_in = w;
-        let finite =
-            state.v.is_finite() && w.is_finite() && state.dx.is_finite() && state.dr.is_finite();
+        let finite = state.v.is_finite() && w.is_finite() && state.dx.is_finite() && q.0.is_finite();
         if finite || !b.dynamic {
             solver.states[i] = if finite { state } else { BodyState::REST };
         } else {
@@ -491,10 +497,11 @@ fn scatter(solver: &ContactSolver, bodies: &mut Query<SolvedBody, Live>) {
         if !b.dynamic {
             continue;
         }
-        if let Ok((_, _, mut v, l, inertia, _)) = bodies.get_mut(b.entity) {
+        if let Ok((_, _, mut v, l, _)) = bodies.get_mut(b.entity) {
             v.0 = state.v;
-            if let (Some(mut l), Some(inertia)) = (l, inertia) {
-                l.bypass_change_detection().0 += inertia.angular_momentum(b.q0, state.w - b.w_in);
+            if let Some(mut l) = l {
+                let dw = glam::Vec3::from(state.w - b.w_in);
+                l.bypass_change_detection().0 += Vec3A::from(b.i0 * dw);
             }
         }
     }

@@ -23,7 +23,7 @@
 //! batch, after the colours. The order is fixed by the order of the manifolds, so results
 //! are bit-identical from run to run.
 
-use std::collections::HashMap;
+use bevy_platform::collections::HashMap;
 
 use bevy_ecs::prelude::*;
 use glam::{Mat3, Quat, Vec3A};
@@ -44,6 +44,8 @@ pub(crate) struct SolverBody {
     pub inv_mass: f32,
     /// World inverse inertia at the start of the step (zero for kinematic bodies).
     pub inv_i: Mat3,
+    /// World inertia at the start of the step (zero for kinematic bodies and particles).
+    pub i0: Mat3,
     /// Centre of mass and rotation at the start of the step.
     pub x0: Vec3A,
     pub q0: Quat,

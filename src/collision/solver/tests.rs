@@ -54,6 +54,7 @@ fn solver_with(bodies: usize, pairs: &[(u32, u32)]) -> ContactSolver {
             entity: Entity::from_raw_u32(i as u32 + 1).unwrap(),
             inv_mass: 1.0 / (1.0 + i as f32),
             inv_i: Mat3::ZERO,
+            i0: Mat3::ZERO,
             x0: Vec3A::ZERO,
             q0: Quat::IDENTITY,
             w_in: Vec3A::ZERO,
