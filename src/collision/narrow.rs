@@ -3,7 +3,7 @@
 use bevy_platform::collections::HashMap;
 
 use bevy_ecs::prelude::*;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use parry3d::query::{ContactManifold, ContactManifoldsWorkspace};
 
 /// What each contact point carries from step to step: the accumulated impulses, for warm
@@ -37,6 +37,76 @@ impl PairState {
             seen: 0,
         }
     }
+}
+
+/// Most points a manifold keeps for the solver: four span any convex contact patch, and
+/// parry's face–face clipping can give eight (a box resting squarely on another), which
+/// doubles the work for no better support.
+pub(crate) const MAX_POINTS: usize = 4;
+
+/// Which of a manifold's points to solve when it has more than [`MAX_POINTS`]: the deepest,
+/// the one farthest from it, the one making the largest triangle with those two, and the one
+/// farthest out on the other side of their line (else the one farthest from the three).
+/// `points` are (position, separation, warm); distances are measured in the contact plane
+/// of normal `n`.
+///
+/// Face–face clipping gives each corner twice (once from each shape's features), at nearly
+/// the same spot and depth, so a plain choice would flip between the copies from step to
+/// step and lose the warm-start impulse each time (measured: a settled 1,000-box heap kept
+/// 4 cm/s of jitter). Points that were solved last step (`warm`) win near-ties: a millimetre
+/// of depth, a percent of spread. Returns the indices kept and their count.
+#[must_use]
+pub(crate) fn keep_points(points: &[(Vec3A, f32, bool)], n: Vec3A) -> ([usize; MAX_POINTS], usize) {
+    let mut keep = [0; MAX_POINTS];
+    if points.len() <= MAX_POINTS {
+        for (i, k) in keep.iter_mut().enumerate().take(points.len()) {
+            *k = i;
+        }
+        return (keep, points.len());
+    }
+    let pos = |i: usize| points[i].0;
+    let argmax = |score: &dyn Fn(Vec3A, f32, bool) -> f32| {
+        let mut best = (0, f32::NEG_INFINITY);
+        for (i, &(p, d, warm)) in points.iter().enumerate() {
+            let s = score(p, d, warm);
+            if s > best.1 {
+                best = (i, s);
+            }
+        }
+        best
+    };
+    let spread = |s: f32, warm: bool| if warm { s * 1.01 } else { s };
+    let (i0, _) = argmax(&|_, d, warm| if warm { 1e-3 - d } else { -d });
+    let p0 = pos(i0);
+    // In-plane distances: the component along n is the separation, not the spread.
+    let (i1, _) = argmax(&|p, _, warm| spread((p - p0).reject_from_normalized(n).length(), warm));
+    // n · ((p1 − p0) × (p − p0)) = m · (p − p0): which side of the line p0p1, and how far.
+    let m = n.cross(pos(i1) - p0);
+    let side = |p: Vec3A| m.dot(p - p0);
+    let (i2, _) = argmax(&|p, _, warm| spread(side(p).abs(), warm));
+    let sign = side(pos(i2)).signum();
+    let (i3, s3) = argmax(&|p, _, warm| spread(-side(p) * sign, warm));
+    let i3 = if s3 > 0.0 {
+        i3
+    } else {
+        let chosen = [i0, i1, i2].map(pos);
+        argmax(&|p, _, warm| {
+            let d = chosen.map(|c| (p - c).reject_from_normalized(n).length());
+            spread(d[0].min(d[1]).min(d[2]), warm)
+        })
+        .0
+    };
+    keep = [i0, i1, i2, i3];
+    keep.sort_unstable();
+    // Degenerate patches (all points on a line or one spot) can pick an index twice.
+    let mut count = 0;
+    for k in 0..MAX_POINTS {
+        if k == 0 || keep[k] != keep[count - 1] {
+            keep[count] = keep[k];
+            count += 1;
+        }
+    }
+    (keep, count)
 }
 
 /// Every pair of colliders whose boxes overlap, with their contact manifolds. A resource:
@@ -161,5 +231,56 @@ impl Contacts {
     #[must_use]
     pub fn touching_count(&self) -> usize {
         self.pairs.values().filter(|s| s.touching).count()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn eight_clipped_points_of_a_square_face_reduce_to_its_four_corners() {
+        // Two coincident unit squares clipped against each other: every corner twice, the
+        // second copy 1 mm less deep.
+        let corners = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)];
+        let points: Vec<(Vec3A, f32, bool)> = corners
+            .iter()
+            .chain(&corners)
+            .enumerate()
+            .map(|(i, &(x, z))| {
+                (
+                    Vec3A::new(x, 1.0, z),
+                    if i < 4 { -0.002 } else { -0.001 },
+                    false,
+                )
+            })
+            .collect();
+        let (keep, count) = keep_points(&points, Vec3A::Y);
+        assert_eq!(count, 4);
+        let mut kept: Vec<(i32, i32)> = keep[..count]
+            .iter()
+            .map(|&i| {
+                let p = points[i].0 * 2.0;
+                (p.x as i32, p.z as i32)
+            })
+            .collect();
+        kept.sort_unstable();
+        assert_eq!(kept, vec![(-1, -1), (-1, 1), (1, -1), (1, 1)]);
+        // The deepest copies are the ones kept.
+        assert!(keep[..count].iter().all(|&i| i < 4), "{keep:?}");
+    }
+
+    #[test]
+    fn few_points_are_kept_as_they_are_and_a_degenerate_patch_does_not_repeat_one() {
+        let p = |x: f32| (Vec3A::new(x, 0.0, 0.0), 0.0, false);
+        assert_eq!(keep_points(&[p(0.0), p(1.0)], Vec3A::Y), ([0, 1, 0, 0], 2));
+        // Six points on one line: both ends, no index twice.
+        let line: Vec<_> = (0..6).map(|i| p(i as f32)).collect();
+        let (keep, count) = keep_points(&line, Vec3A::Y);
+        let kept = &keep[..count];
+        assert!(kept.contains(&0) && kept.contains(&5), "{kept:?}");
+        let mut unique = kept.to_vec();
+        unique.dedup();
+        assert_eq!(unique.len(), count);
     }
 }

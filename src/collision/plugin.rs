@@ -6,7 +6,7 @@ use parry3d::math::Pose;
 use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 
 use super::broad::{BroadPhase, Entry};
-use super::narrow::{ContactImpulse, Contacts, PairState};
+use super::narrow::{ContactImpulse, Contacts, PairState, keep_points};
 use super::solver::{
     BodyState, ContactSolver, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody,
 };
@@ -369,9 +369,11 @@ fn prepare_contacts(
     bp: Res<BroadPhase>,
     settings: Res<ContactSettings>,
     bodies: Query<PreparedBody, (With<Collider>, Live)>,
+    mut world: Local<Vec<(Vec3A, f32, bool)>>,
 ) {
     let s = &mut *solver;
     s.clear();
+    let world = &mut *world;
     for &(ea, eb) in &bp.pairs {
         let Some(state) = contacts.pairs.get(&(ea, eb)) else {
             continue;
@@ -408,10 +410,15 @@ fn prepare_contacts(
             let n = Vec3A::from(pose_a.rotation * m.local_n1);
             let t = tangent_basis(n, m, &pose_a, &pose_b, (a.0.0, va, wa), (b.0.0, vb, wb));
             let first = s.inputs.len() as u32;
-            for p in &m.points {
+            world.clear();
+            world.extend(m.points.iter().map(|p| {
                 let pa = Vec3A::from(pose_a * p.local_p1);
                 let pb = Vec3A::from(pose_b * p.local_p2);
-                let mid = 0.5 * (pa + pb);
+                (0.5 * (pa + pb), p.dist, p.data != ContactImpulse::default())
+            }));
+            let (keep, count) = keep_points(world, n);
+            for &k in &keep[..count] {
+                let (p, mid) = (&m.points[k], world[k].0);
                 let (r_a, r_b) = (mid - a.0.0, mid - b.0.0);
                 let rel = (vb + wb.cross(r_b)) - (va + wa.cross(r_a));
                 let tangent = Vec3A::from(p.data.tangent);
@@ -422,6 +429,7 @@ fn prepare_contacts(
                     n_imp: p.data.normal,
                     t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
                     approach: n.dot(rel),
+                    source: k as u32,
                 });
             }
             s.manifolds.push(ManifoldConstraint {
@@ -474,7 +482,8 @@ fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
             dr,
         };
         b.w_in = w;
-        let finite = state.v.is_finite() && w.is_finite() && state.dx.is_finite() && q.0.is_finite();
+        let finite =
+            state.v.is_finite() && w.is_finite() && state.dx.is_finite() && q.0.is_finite();
         if finite || !b.dynamic {
             solver.states[i] = if finite { state } else { BodyState::REST };
         } else {
@@ -545,6 +554,16 @@ fn relax_contacts(
     solver.solve(time.h, soft, fixed, false, settings.max_push_velocity);
     if time.is_last() {
         solver.restitution(settings.restitution_threshold);
+        // Points the solver left out (beyond four per manifold) start from zero if kept later.
+        for m in &solver.manifolds {
+            let tracked = contacts
+                .pairs
+                .get_mut(&m.pair)
+                .and_then(|s| s.manifolds.get_mut(m.manifold as usize));
+            for p in tracked.into_iter().flat_map(|m| &mut m.points) {
+                p.data = ContactImpulse::default();
+            }
+        }
         for (mi, k, normal, tangent) in solver.impulses() {
             let m = &solver.manifolds[mi as usize];
             let tracked = contacts

@@ -105,14 +105,15 @@ pub(crate) struct PointInput {
     pub t_imp: [f32; 2],
     /// Relative normal velocity at the start of the step (negative when approaching).
     pub approach: f32,
+    /// Index of the point in the narrow phase's manifold (where its impulses are kept).
+    pub source: u32,
 }
 
-/// One direction (normal or tangent) of four contact points, with everything the solver
-/// needs precomputed: the lever products r × d, their images I⁻¹(r × d), the effective mass.
+/// One direction (normal or tangent) of four contact points, with what the solver needs
+/// precomputed: the angular velocity change per unit impulse I⁻¹(r × d) of each side, and
+/// the effective mass.
 #[derive(Debug, Clone, Copy, Default)]
 struct Axis {
-    rd_a: V3,
-    rd_b: V3,
     ird_a: V3,
     ird_b: V3,
     mass: F4,
@@ -128,8 +129,6 @@ impl Axis {
         let k = ma + mb + rd_a.dot(ird_a) + rd_b.dot(ird_b);
         let usable = k.simd_gt(F4::ZERO) & live;
         Self {
-            rd_a,
-            rd_b,
             ird_a,
             ird_b,
             mass: usable.select(F4::ONE / k, F4::ZERO),
@@ -250,10 +249,12 @@ struct Side {
 }
 
 impl Side {
-    /// Relative velocity of b against a along `d` at the points.
+    /// Velocity of b's material point against a's at the contact points (lever arms `r_a`,
+    /// `r_b`). Its component along a direction d equals d·(v_b − v_a) + ω_b·(r_b × d) −
+    /// ω_a·(r_a × d), so the lever products need not be stored.
     #[inline]
-    fn along(a: &Side, b: &Side, d: V3, axis: &Axis) -> F4 {
-        d.dot(b.v - a.v) + b.w.dot(axis.rd_b) - a.w.dot(axis.rd_a)
+    fn relative(a: &Side, b: &Side, r_a: V3, r_b: V3) -> V3 {
+        (b.v + b.w.cross(r_b)) - (a.v + a.w.cross(r_a))
     }
 
     /// Applies impulse λ along `d`: −λ to a, +λ to b.
@@ -375,23 +376,31 @@ impl ContactSolver {
             fixed: F4::new(fixed.map(|f| if f { f32::from_bits(!0) } else { 0.0 })),
         };
         for k in 0..count {
-            let input = |l: usize| {
-                lane(l)
-                    .filter(|m| k < m.count)
-                    .map(|m| self.inputs[(m.first + k) as usize])
-            };
-            let p: [Option<PointInput>; 4] = std::array::from_fn(input);
-            let get = |f: fn(&PointInput) -> f32| F4::new(p.map(|p| p.as_ref().map_or(0.0, f)));
+            // Lanes past a manifold's last point stay zero (their masses are zeroed too).
+            let (mut r_a, mut r_b) = ([Vec3A::ZERO; 4], [Vec3A::ZERO; 4]);
+            let mut s = [[0.0f32; 4]; 5];
+            for (l, &mi) in chunk.iter().enumerate() {
+                let m = &self.manifolds[mi as usize];
+                if k < m.count {
+                    let p = &self.inputs[(m.first + k) as usize];
+                    (r_a[l], r_b[l]) = (p.r_a, p.r_b);
+                    s[0][l] = p.base;
+                    s[1][l] = p.n_imp;
+                    s[2][l] = p.t_imp[0];
+                    s[3][l] = p.t_imp[1];
+                    s[4][l] = p.approach;
+                }
+            }
             self.points.push(Point {
-                r_a: V3::from_lanes(p.map(|p| p.map_or(Vec3A::ZERO, |p| p.r_a))),
-                r_b: V3::from_lanes(p.map(|p| p.map_or(Vec3A::ZERO, |p| p.r_b))),
-                base: get(|p| p.base),
+                r_a: V3::from_lanes(r_a),
+                r_b: V3::from_lanes(r_b),
+                base: F4::new(s[0]),
                 normal: Axis::default(),
                 tangent: [Axis::default(); 2],
-                n_imp: get(|p| p.n_imp),
-                t_imp: [get(|p| p.t_imp[0]), get(|p| p.t_imp[1])],
+                n_imp: F4::new(s[1]),
+                t_imp: [F4::new(s[2]), F4::new(s[3])],
                 max_n: F4::ZERO,
-                approach: get(|p| p.approach),
+                approach: F4::new(s[4]),
                 vn_seen: [F4::splat(f32::NAN); 2],
             });
         }
@@ -555,7 +564,7 @@ impl ContactSolver {
                 let bias = speculative.select(s * inv_h, (bias_rate * s).fast_max(max_push));
                 let m_scale = speculative.select(one, mass_scale);
                 let i_scale = speculative.select(zero, impulse_scale);
-                let vn = Side::along(&a, &b, batch.n, &p.normal);
+                let vn = batch.n.dot(Side::relative(&a, &b, p.r_a, p.r_b));
                 if use_bias {
                     p.vn_seen = [p.vn_seen[1], vn];
                 }
@@ -584,9 +593,10 @@ impl ContactSolver {
     fn friction(batch: &Batch, points: &mut [Point], a: &mut Side, b: &mut Side) {
         for p in points {
             let old = p.t_imp;
+            let rel = Side::relative(a, b, p.r_a, p.r_b);
             let new = [
-                old[0] - p.tangent[0].mass * Side::along(a, b, batch.t[0], &p.tangent[0]),
-                old[1] - p.tangent[1].mass * Side::along(a, b, batch.t[1], &p.tangent[1]),
+                old[0] - p.tangent[0].mass * batch.t[0].dot(rel),
+                old[1] - p.tangent[1].mass * batch.t[1].dot(rel),
             ];
             let limit = batch.friction * p.n_imp;
             let len2 = new[0] * new[0] + new[1] * new[1];
@@ -619,7 +629,7 @@ impl ContactSolver {
                 if !hit.any() {
                     continue;
                 }
-                let vn = Side::along(&a, &b, batch.n, &p.normal);
+                let vn = batch.n.dot(Side::relative(&a, &b, p.r_a, p.r_b));
                 let imp = -p.normal.mass * (vn + batch.restitution * p.approach);
                 let total = hit.select((p.n_imp + imp).fast_max(zero), p.n_imp);
                 let imp = total - p.n_imp;
@@ -632,7 +642,8 @@ impl ContactSolver {
     }
 
     /// The accumulated impulses of every point, for the next step's warm start: manifold
-    /// index, point index within it, normal impulse and tangent impulse vector.
+    /// index, the point's index in the narrow phase's manifold, normal impulse and tangent
+    /// impulse vector.
     pub fn impulses(&self) -> impl Iterator<Item = (u32, u32, f32, Vec3A)> + '_ {
         self.batches.iter().flat_map(move |batch| {
             let points = &self.points[batch.first as usize..(batch.first + batch.count) as usize];
@@ -642,19 +653,12 @@ impl ContactSolver {
                     self.manifolds.get(mi as usize).map(|m| (l, mi, m))
                 })
                 .flat_map(move |(l, mi, m)| {
-                    points
-                        .iter()
-                        .take(m.count as usize)
-                        .enumerate()
-                        .map(move |(k, p)| {
-                            let t = [p.t_imp[0].to_array()[l], p.t_imp[1].to_array()[l]];
-                            (
-                                mi,
-                                k as u32,
-                                p.n_imp.to_array()[l],
-                                t[0] * m.t[0] + t[1] * m.t[1],
-                            )
-                        })
+                    let sources = &self.inputs[m.first as usize..(m.first + m.count) as usize];
+                    points.iter().zip(sources).map(move |(p, input)| {
+                        let t = [p.t_imp[0].to_array()[l], p.t_imp[1].to_array()[l]];
+                        let tangent = t[0] * m.t[0] + t[1] * m.t[1];
+                        (mi, input.source, p.n_imp.to_array()[l], tangent)
+                    })
                 })
         })
     }
