@@ -4,7 +4,7 @@
 
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 
-use glam::{Mat3, Vec3A};
+use glam::{Mat3A, Vec3A};
 use wide::f32x4;
 
 /// Four scalars, one per lane.
@@ -128,14 +128,14 @@ impl M3 {
     /// Lane `i` holds `m[i]`.
     #[inline]
     #[must_use]
-    pub fn from_lanes(m: [&Mat3; 4]) -> Self {
-        let col = |c: usize| V3::from_lanes(std::array::from_fn(|i| Vec3A::from(m[i].col(c))));
+    pub fn from_lanes(m: [&Mat3A; 4]) -> Self {
+        let col = |c: usize| V3::from_lanes(std::array::from_fn(|i| m[i].col(c)));
         Self {
             cols: [col(0), col(1), col(2)],
         }
     }
 
-    /// M v, lane by lane (the same sums in the same order as glam's `Mat3 * Vec3`).
+    /// M v, lane by lane (the same sums in the same order as glam's `Mat3A * Vec3`).
     #[inline]
     #[must_use]
     pub fn mul_vec(&self, v: V3) -> V3 {
@@ -165,10 +165,10 @@ mod tests {
         let crosses = va.cross(vb).lanes();
         let sums = (va + vb).lanes();
         let m = [
-            Mat3::from_cols_array(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]),
-            Mat3::IDENTITY,
-            Mat3::from_diagonal(glam::Vec3::new(2.0, 3.0, 4.0)),
-            Mat3::from_quat(glam::Quat::from_rotation_y(0.7)),
+            Mat3A::from_cols_array(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0]),
+            Mat3A::IDENTITY,
+            Mat3A::from_diagonal(glam::Vec3::new(2.0, 3.0, 4.0)),
+            Mat3A::from_quat(glam::Quat::from_rotation_y(0.7)),
         ];
         let mv = M3::from_lanes([&m[0], &m[1], &m[2], &m[3]])
             .mul_vec(va)
@@ -177,7 +177,7 @@ mod tests {
             assert_eq!(dots[i], a[i].dot(b[i]));
             assert_eq!(crosses[i], a[i].cross(b[i]));
             assert_eq!(sums[i], a[i] + b[i]);
-            let want = m[i] * glam::Vec3::from(a[i]);
+            let want = m[i] * a[i];
             assert!((Vec3A::from(want) - mv[i]).length() < 1e-6, "lane {i}");
         }
     }

@@ -1,7 +1,7 @@
 //! Collision systems: bounding boxes, broad phase, narrow phase, contact solver.
 
 use bevy_ecs::prelude::*;
-use glam::{Mat3, Quat, Vec3, Vec3A};
+use glam::{Mat3A, Quat, Vec3, Vec3A};
 use parry3d::math::Pose;
 use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 
@@ -310,10 +310,12 @@ fn body_index(
     let dynamic = !mass.is_pinned();
     let (inv_i, i0) = match inertia {
         Some(i) if dynamic && !i.is_infinite() => {
-            let r = Mat3::from_quat(q.0);
-            (i.world_inverse_tensor(q.0), r * i.tensor() * r.transpose())
+            let r = Mat3A::from_quat(q.0);
+            let tensor = Mat3A::from(i.tensor());
+            let inverse = Mat3A::from(i.world_inverse_tensor(q.0));
+            (inverse, r * tensor * r.transpose())
         }
-        _ => (Mat3::ZERO, Mat3::ZERO),
+        _ => (Mat3A::ZERO, Mat3A::ZERO),
     };
     let i = solver.bodies.len() as u32;
     solver.bodies.push(SolverBody {
@@ -465,13 +467,12 @@ fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
         let Ok((x, q, v, l, w)) = bodies.get(b.entity) else {
             continue;
         };
-        let dr = Mat3::from_quat(q.0 * b.q0.inverse());
+        let dr = Mat3A::from_quat(q.0 * b.q0.inverse());
         // ω = I(q)⁻¹ L, with I(q)⁻¹ = ΔR I₀⁻¹ ΔRᵀ: three matrix products instead of the
         // quaternion round trip through the principal frame.
         let w = match l {
             Some(l) if b.dynamic => {
-                let l = glam::Vec3::from(l.0);
-                Vec3A::from(dr * (b.inv_i * (dr.transpose() * l)))
+                dr * (b.inv_i * (dr.transpose() * l.0))
             }
             _ => w.map_or(Vec3A::ZERO, |w| w.0),
         };
@@ -509,8 +510,7 @@ fn scatter(solver: &ContactSolver, bodies: &mut Query<SolvedBody, Live>) {
         if let Ok((_, _, mut v, l, _)) = bodies.get_mut(b.entity) {
             v.0 = state.v;
             if let Some(mut l) = l {
-                let dw = glam::Vec3::from(state.w - b.w_in);
-                l.bypass_change_detection().0 += Vec3A::from(b.i0 * dw);
+                l.bypass_change_detection().0 += b.i0 * (state.w - b.w_in);
             }
         }
     }

@@ -26,7 +26,7 @@
 use bevy_platform::collections::HashMap;
 
 use bevy_ecs::prelude::*;
-use glam::{Mat3, Quat, Vec3A};
+use glam::{Mat3A, Quat, Vec3A};
 
 use super::lanes::{F4, M3, V3};
 
@@ -43,9 +43,9 @@ pub(crate) struct SolverBody {
     /// Zero for kinematic bodies: they drive contacts but are never pushed.
     pub inv_mass: f32,
     /// World inverse inertia at the start of the step (zero for kinematic bodies).
-    pub inv_i: Mat3,
+    pub inv_i: Mat3A,
     /// World inertia at the start of the step (zero for kinematic bodies and particles).
-    pub i0: Mat3,
+    pub i0: Mat3A,
     /// Centre of mass and rotation at the start of the step.
     pub x0: Vec3A,
     pub q0: Quat,
@@ -63,7 +63,7 @@ pub(crate) struct BodyState {
     pub w: Vec3A,
     /// Displacement and rotation (as a matrix) since the start of the step.
     pub dx: Vec3A,
-    pub dr: Mat3,
+    pub dr: Mat3A,
 }
 
 impl BodyState {
@@ -72,7 +72,7 @@ impl BodyState {
         v: Vec3A::ZERO,
         w: Vec3A::ZERO,
         dx: Vec3A::ZERO,
-        dr: Mat3::IDENTITY,
+        dr: Mat3A::IDENTITY,
     };
 }
 
@@ -411,7 +411,7 @@ impl ContactSolver {
     /// The effective masses and lever terms of every point of batch `bi`, from its bodies'
     /// current inverse masses and inertias.
     fn compute_axes(&mut self, bi: usize) {
-        const ZERO: Mat3 = Mat3::ZERO;
+        const ZERO: Mat3A = Mat3A::ZERO;
         let batch = self.batches[bi];
         let body = |i: u32| self.bodies.get(i as usize);
         let inv_m = |ix: [u32; 4]| F4::new(ix.map(|i| body(i).map_or(0.0, |b| b.inv_mass)));

@@ -17,7 +17,7 @@ fn lanes(v: Vec3A) -> V3 {
     V3::from_lanes([v; 4])
 }
 
-fn axis_mass(ma: f32, ia: Mat3, ra: Vec3A, mb: f32, ib: Mat3, rb: Vec3A, d: Vec3A) -> f32 {
+fn axis_mass(ma: f32, ia: Mat3A, ra: Vec3A, mb: f32, ib: Mat3A, rb: Vec3A, d: Vec3A) -> f32 {
     let live = F4::splat(f32::from_bits(!0));
     let (ia, ib) = (M3::from_lanes([&ia; 4]), M3::from_lanes([&ib; 4]));
     let axis = Axis::new(
@@ -35,11 +35,11 @@ fn axis_mass(ma: f32, ia: Mat3, ra: Vec3A, mb: f32, ib: Mat3, rb: Vec3A, d: Vec3
 
 #[test]
 fn effective_mass_of_a_point_mass_and_a_lever() {
-    let z = Mat3::ZERO;
+    let z = Mat3A::ZERO;
     let o = Vec3A::ZERO;
     assert_eq!(axis_mass(0.5, z, o, 0.0, z, o, Vec3A::Y), 2.0);
     // A unit-inertia body hit at r = x along y: k = 1/m + |r × n|² / I = 1 + 1.
-    let i = Mat3::IDENTITY;
+    let i = Mat3A::IDENTITY;
     assert!((axis_mass(1.0, i, Vec3A::X, 0.0, z, o, Vec3A::Y) - 0.5).abs() < 1e-6);
     // Nothing can move: no impulse at all (not an infinite one).
     assert_eq!(axis_mass(0.0, z, Vec3A::X, 0.0, z, Vec3A::X, Vec3A::Y), 0.0);
@@ -53,8 +53,8 @@ fn solver_with(bodies: usize, pairs: &[(u32, u32)]) -> ContactSolver {
         s.bodies.push(SolverBody {
             entity: Entity::from_raw_u32(i as u32 + 1).unwrap(),
             inv_mass: 1.0 / (1.0 + i as f32),
-            inv_i: Mat3::ZERO,
-            i0: Mat3::ZERO,
+            inv_i: Mat3A::ZERO,
+            i0: Mat3A::ZERO,
             x0: Vec3A::ZERO,
             q0: Quat::IDENTITY,
             w_in: Vec3A::ZERO,
