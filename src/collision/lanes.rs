@@ -178,7 +178,7 @@ mod tests {
             assert_eq!(crosses[i], a[i].cross(b[i]));
             assert_eq!(sums[i], a[i] + b[i]);
             let want = m[i] * a[i];
-            assert!((Vec3A::from(want) - mv[i]).length() < 1e-6, "lane {i}");
+            assert!((want - mv[i]).length() < 1e-6, "lane {i}");
         }
     }
 }
