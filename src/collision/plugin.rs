@@ -310,10 +310,8 @@ fn body_index(
     let dynamic = !mass.is_pinned();
     let (inv_i, i0) = match inertia {
         Some(i) if dynamic && !i.is_infinite() => {
-            let r = Mat3A::from_quat(q.0);
-            let tensor = Mat3A::from(i.tensor());
-            let inverse = Mat3A::from(i.world_inverse_tensor(q.0));
-            (inverse, r * tensor * r.transpose())
+            let (tensor, inverse) = i.world_tensors(q.0);
+            (inverse, tensor)
         }
         _ => (Mat3A::ZERO, Mat3A::ZERO),
     };
@@ -337,18 +335,20 @@ fn body_index(
 /// arbitrary basis the per-point friction impulses of a face contact twist against each
 /// other through the body's rotation and their sum falls short of μN (measured: a box
 /// crept down a 30° slope at μ = 0.6).
+///
+/// `centre` is the mean of the manifold's points: the mean relative velocity of the points
+/// is the relative velocity at their mean, since velocity is affine in position.
 fn tangent_basis(
     n: Vec3A,
     m: &super::narrow::Manifold,
-    pose_a: &Pose,
-    pose_b: &Pose,
+    centre: Vec3A,
     (xa, va, wa): (Vec3A, Vec3A, Vec3A),
     (xb, vb, wb): (Vec3A, Vec3A, Vec3A),
 ) -> [Vec3A; 2] {
-    let (mut slide, mut impulse, mut normal) = (Vec3A::ZERO, Vec3A::ZERO, 0.0f32);
+    let count = m.points.len() as f32;
+    let slide = count * ((vb + wb.cross(centre - xb)) - (va + wa.cross(centre - xa)));
+    let (mut impulse, mut normal) = (Vec3A::ZERO, 0.0f32);
     for p in &m.points {
-        let mid = 0.5 * (Vec3A::from(*pose_a * p.local_p1) + Vec3A::from(*pose_b * p.local_p2));
-        slide += (vb + wb.cross(mid - xb)) - (va + wa.cross(mid - xa));
         impulse += Vec3A::from(p.data.tangent);
         normal += p.data.normal;
     }
@@ -410,14 +410,15 @@ fn prepare_contacts(
                 continue;
             }
             let n = Vec3A::from(pose_a.rotation * m.local_n1);
-            let t = tangent_basis(n, m, &pose_a, &pose_b, (a.0.0, va, wa), (b.0.0, vb, wb));
-            let first = s.inputs.len() as u32;
             world.clear();
             world.extend(m.points.iter().map(|p| {
                 let pa = Vec3A::from(pose_a * p.local_p1);
                 let pb = Vec3A::from(pose_b * p.local_p2);
                 (0.5 * (pa + pb), p.dist, p.data != ContactImpulse::default())
             }));
+            let centre = world.iter().map(|w| w.0).sum::<Vec3A>() / world.len() as f32;
+            let t = tangent_basis(n, m, centre, (a.0.0, va, wa), (b.0.0, vb, wb));
+            let first = s.inputs.len() as u32;
             let (keep, count) = keep_points(world, n);
             for &k in &keep[..count] {
                 let (p, mid) = (&m.points[k], world[k].0);
@@ -471,9 +472,7 @@ fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
         // ω = I(q)⁻¹ L, with I(q)⁻¹ = ΔR I₀⁻¹ ΔRᵀ: three matrix products instead of the
         // quaternion round trip through the principal frame.
         let w = match l {
-            Some(l) if b.dynamic => {
-                dr * (b.inv_i * (dr.transpose() * l.0))
-            }
+            Some(l) if b.dynamic => dr * (b.inv_i * (dr.transpose() * l.0)),
             _ => w.map_or(Vec3A::ZERO, |w| w.0),
         };
         let state = BodyState {

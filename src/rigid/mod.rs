@@ -226,6 +226,22 @@ impl Inertia {
         r * glam::Mat3::from_diagonal(self.inverse.into()) * r.transpose()
     }
 
+    /// The world tensor I = R I₀ Rᵀ and its inverse for orientation `q`, from one rotation
+    /// matrix (zero inverse for infinite inertia).
+    #[must_use]
+    pub fn world_tensors(&self, q: Quat) -> (glam::Mat3A, glam::Mat3A) {
+        let r = glam::Mat3A::from_quat(unit(q) * self.frame);
+        let scaled =
+            |d: Vec3A| glam::Mat3A::from_cols(r.x_axis * d.x, r.y_axis * d.y, r.z_axis * d.z);
+        let rt = r.transpose();
+        let tensor = if self.is_infinite() {
+            glam::Mat3A::ZERO
+        } else {
+            scaled(self.principal) * rt
+        };
+        (tensor, scaled(self.inverse) * rt)
+    }
+
     /// True for infinite inertia (a body torques cannot turn).
     #[must_use]
     pub fn is_infinite(&self) -> bool {
@@ -471,6 +487,26 @@ pub(crate) fn check_density(density: f32) -> Result<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn world_tensors_are_inverse_and_match_the_single_ones() {
+        let inertia = Inertia::new(
+            Vec3::new(1.0, 2.0, 3.0),
+            Quat::from_rotation_z(0.3).normalize(),
+        )
+        .unwrap();
+        let q = Quat::from_euler(glam::EulerRot::XYZ, 0.4, -1.1, 2.0);
+        let (tensor, inverse) = inertia.world_tensors(q);
+        let product = tensor * inverse;
+        assert!(
+            product.abs_diff_eq(glam::Mat3A::IDENTITY, 1e-5),
+            "{product}"
+        );
+        let single = glam::Mat3A::from(inertia.world_inverse_tensor(q));
+        assert!(inverse.abs_diff_eq(single, 1e-6));
+        let (t, i) = Inertia::INFINITE.world_tensors(q);
+        assert_eq!((t, i), (glam::Mat3A::ZERO, glam::Mat3A::ZERO));
+    }
 
     #[test]
     fn omega_and_momentum_are_inverse_for_any_orientation() {
