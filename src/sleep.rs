@@ -8,8 +8,9 @@
 //! archetype filter: a sleeping body costs nothing per substep). Sleeping bodies stay solid:
 //! awake bodies collide with them as with static ones.
 //!
-//! **Waking.** An island with a sleeping and a moving member wakes whole (so a body that
-//! lands on a sleeping stack wakes it the next step). Game code wakes a body by writing its
+//! **Waking.** An island with a sleeping and a moving member wakes whole, within the step in
+//! which an awake body touches it or could reach it (so whatever hits a sleeping stack
+//! pushes it in the step of impact, not as a wall). Game code wakes a body by writing its
 //! position, rotation or velocity, or by adding an external force, torque or impulse; or by
 //! removing [`Sleeping`] directly.
 //!
@@ -21,7 +22,7 @@ use bevy_platform::collections::HashMap;
 use bevy_ecs::prelude::*;
 
 use crate::Plugin;
-use crate::collision::{Collider, Contacts};
+use crate::collision::{Collider, ContactSettings, Contacts};
 use crate::particles::{ExternalForce, ExternalImpulse, LinearVelocity, Mass, Position};
 use crate::quarantine::Quarantined;
 use crate::rigid::{
@@ -112,6 +113,103 @@ fn wake_on_user_change(
         timer.0 = 0.0;
         commands.entity(e).remove::<Sleeping>();
     }
+}
+
+/// Wakes, within the step, every sleeping island that an awake body is about to hit: one
+/// that touches it, or that could close the gap in this step at its current speed. (Waiting
+/// for the next step's islands would let the sleeper stand like a wall for the step of
+/// impact: a ball fired at a sleeping box stopped dead and the box never moved.) Runs
+/// between the narrow phase and the contact constraints; its removals of [`Sleeping`] are
+/// applied before the constraints are built.
+pub(crate) fn wake_hit_islands(
+    mut commands: Commands,
+    time: Res<PhysicsTime>,
+    settings: Res<ContactSettings>,
+    mut contacts: ResMut<Contacts>,
+    sleepers: Query<(), With<Sleeping>>,
+    movers: Query<(&LinearVelocity, Option<&Mass>), Without<Sleeping>>,
+    mut timers: Query<&mut SleepTimer>,
+) {
+    let (dt, touch) = (time.dt(), 0.25 * settings.margin);
+    let mut woken = Vec::new();
+    let mut asleep_pairs = Vec::new();
+    // The broad phase pairs a sleeper with nothing static either: (sleeper, pair).
+    let mut grounded = Vec::new();
+    for (&(a, b), state) in &contacts.pairs {
+        if state.sensor {
+            continue;
+        }
+        let (sa, sb) = (sleepers.contains(a), sleepers.contains(b));
+        if sa && sb {
+            if state.touching {
+                asleep_pairs.push((a, b));
+            }
+            continue;
+        }
+        let (sleeper, other) = match (sa, sb) {
+            (true, false) => (a, b),
+            (false, true) => (b, a),
+            _ => continue,
+        };
+        // Static colliders (no velocity) and resting pinned bodies wake nothing.
+        let Ok((v, mass)) = movers.get(other) else {
+            if state.touching {
+                grounded.push((sleeper, (a, b)));
+            }
+            continue;
+        };
+        let speed = v.0.length();
+        if mass.is_none_or(|m| m.is_pinned()) && speed == 0.0 {
+            continue;
+        }
+        let reach = touch + speed * dt;
+        let points = state.manifolds.iter().flat_map(|m| &m.points);
+        if points.into_iter().any(|p| p.dist < reach) {
+            woken.push(sleeper);
+        }
+    }
+    if woken.is_empty() {
+        return;
+    }
+    // The whole island wakes: spread over the touching pairs of sleepers.
+    woken.sort_unstable();
+    woken.dedup();
+    asleep_pairs.sort_unstable();
+    let mut grew = true;
+    while grew {
+        grew = false;
+        for &(a, b) in &asleep_pairs {
+            let (ia, ib) = (woken.binary_search(&a), woken.binary_search(&b));
+            let new = match (ia, ib) {
+                (Ok(_), Err(at)) => Some((b, at)),
+                (Err(at), Ok(_)) => Some((a, at)),
+                _ => None,
+            };
+            if let Some((e, at)) = new {
+                woken.insert(at, e);
+                grew = true;
+            }
+        }
+    }
+    for &e in &woken {
+        if let Ok(mut timer) = timers.get_mut(e) {
+            timer.0 = 0.0;
+        }
+        commands.entity(e).remove::<Sleeping>();
+    }
+    let is_woken = |e: &Entity| woken.binary_search(e).is_ok();
+    contacts.woken.extend(
+        asleep_pairs
+            .into_iter()
+            .filter(|(a, b)| is_woken(a) && is_woken(b)),
+    );
+    grounded.sort_unstable();
+    contacts.woken.extend(
+        grounded
+            .into_iter()
+            .filter(|(s, _)| is_woken(s))
+            .map(|(_, p)| p),
+    );
 }
 
 fn find(parent: &mut [usize], mut i: usize) -> usize {

@@ -115,6 +115,9 @@ pub(crate) fn keep_points(points: &[(Vec3A, f32, bool)], n: Vec3A) -> ([usize; M
 pub struct Contacts {
     pub(crate) pairs: HashMap<(Entity, Entity), PairState>,
     pub(crate) step: u64,
+    /// Touching pairs inside islands woken this step: the broad phase skipped them while
+    /// they slept, but their manifolds still hold (nothing moved).
+    pub(crate) woken: Vec<(Entity, Entity)>,
 }
 
 /// A touching pair, as reported by [`Contacts`].

@@ -46,6 +46,7 @@ impl Plugin for CollisionPlugin {
                 update_fixed_aabbs.run_if(fixed_dirty),
                 run_broad_phase,
                 update_contacts,
+                crate::sleep::wake_hit_islands.run_if(any_with_component::<Sleeping>),
                 prepare_contacts,
             )
                 .chain()
@@ -206,6 +207,7 @@ fn update_contacts(
 ) {
     let dt = time.dt();
     contacts.step += 1;
+    contacts.woken.clear();
     let step = contacts.step;
     let touch = 0.25 * settings.margin;
     for &(a, b) in &bp.pairs {
@@ -376,7 +378,7 @@ fn prepare_contacts(
     let s = &mut *solver;
     s.clear();
     let world = &mut *world;
-    for &(ea, eb) in &bp.pairs {
+    for &(ea, eb) in bp.pairs.iter().chain(&contacts.woken) {
         let Some(state) = contacts.pairs.get(&(ea, eb)) else {
             continue;
         };
