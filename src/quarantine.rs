@@ -47,6 +47,11 @@ pub struct BodyQuarantined {
     pub reason: QuarantineReason,
 }
 
+/// Remove hook of the validated components: removing a velocity makes a collider static.
+pub(crate) fn structure_changed(mut world: DeferredWorld, ctx: HookContext) {
+    crate::collision::mark_broad_phase_dirty(&mut world, ctx.entity);
+}
+
 fn report_quarantine(mut world: DeferredWorld, ctx: HookContext) {
     crate::collision::mark_broad_phase_dirty(&mut world, ctx.entity);
     let Some(reason) = world
@@ -77,11 +82,15 @@ pub(crate) trait Validate {
     fn validate(&self) -> Result<(), Error>;
 }
 
-/// Insert hook shared by every validated component: quarantine on a bad value.
+/// Insert hook shared by every validated component: quarantine on a bad value. An insert
+/// on a collider's entity (a new pose for a static collider, a velocity that makes it move)
+/// also tells the broad phase to re-read its lists: that is how it learns of changes without
+/// scanning every collider each step.
 pub(crate) fn validate_on_insert<T: Component + Validate>(
     mut world: DeferredWorld,
     ctx: HookContext,
 ) {
+    crate::collision::mark_broad_phase_dirty(&mut world, ctx.entity);
     let Some(Err(err)) = world.get::<T>(ctx.entity).map(Validate::validate) else {
         return;
     };

@@ -59,8 +59,9 @@ impl Default for BroadPhase {
     }
 }
 
-/// Marks both lists out of date. Called from the component hooks of [`super::Collider`],
-/// the validated pose components and [`crate::Quarantined`]: inserts and removals are how the
+/// Marks both lists out of date. Called from the component hooks of [`super::Collider`], of
+/// every validated component (insert: a new pose or velocity; remove: a velocity taken away
+/// makes a collider static) and of [`crate::Quarantined`]: inserts and removals are how the
 /// broad phase learns about changes without scanning every collider each step.
 pub(crate) fn mark_dirty(world: &mut bevy_ecs::world::DeferredWorld, entity: Entity) {
     if world.get::<super::Collider>(entity).is_none() {
