@@ -352,39 +352,6 @@ fn the_pile_example_scene_runs_clean_and_comes_to_rest_on_the_ramp_and_ground() 
 }
 
 #[test]
-fn a_static_collider_moves_when_its_position_is_inserted_again() {
-    let mut w = world(4);
-    scenes::ground(&mut w).unwrap();
-    let shelf = w
-        .spawn((
-            RigidBodyBundle::fixed(Vec3::new(0.0, 2.0, 0.0), Quat::IDENTITY).unwrap(),
-            Collider::cuboid(1.0, 0.1, 1.0).unwrap(),
-        ))
-        .id();
-    let ball = scenes::dynamic_ball(&mut w, 0.2, Vec3::new(0.0, 3.0, 0.0)).unwrap();
-    for _ in 0..60 {
-        w.step_physics();
-    }
-    assert!(
-        (pos(&w, ball).y - 2.3).abs() < 0.01,
-        "the ball should rest on the shelf: {}",
-        pos(&w, ball)
-    );
-    // Static colliders cost nothing while idle because the broad phase hears of changes
-    // through hooks: inserting a new Position is how a static collider moves.
-    w.entity_mut(shelf)
-        .insert(Position::try_new(Vec3::new(10.0, 2.0, 0.0)).unwrap());
-    for _ in 0..60 {
-        w.step_physics();
-    }
-    assert!(
-        (pos(&w, ball).y - 0.2).abs() < 0.01,
-        "the ball should have dropped to the ground: {}",
-        pos(&w, ball)
-    );
-}
-
-#[test]
 fn nan_in_one_box_of_a_stack_does_not_cross_the_contacts() {
     let mut w = world(4);
     let boxes = scenes::box_column(&mut w, 3).unwrap();
