@@ -515,11 +515,13 @@ impl ContactSolver {
         }
     }
 
-    /// One pass over every contact: normal impulses (with the soft bias when `use_bias`) and
-    /// friction. With the bias, friction goes first: the soft normal solve relaxes the
-    /// accumulated normal impulse by S_i, and a friction limit taken from that relaxed value
-    /// would let bodies creep. The relax pass solves the normal first, so its friction sees
-    /// the full normal impulse.
+    /// One pass over every contact: normal impulses, with the soft bias when `use_bias`;
+    /// friction only in the relax pass (without bias), after the normals, so that its limit
+    /// is the full normal impulse and it never reacts to push-out velocities. The warm start
+    /// carries last pass's friction into the biased pass, which keeps resting bodies from
+    /// creeping (measured: 0.44 mm in 2 s on a 30° slope at μ = 0.6). Friction in the biased
+    /// pass as well (rapier also leaves it out) cost a fifth of the pass and left a heavy box
+    /// on a light one jittering at 8 mm/s instead of 1 mm/s.
     pub fn solve(
         &mut self,
         h: f32,
@@ -554,9 +556,6 @@ impl ContactSolver {
                 (zero, one, zero)
             };
             let range = batch.first as usize..(batch.first + batch.count) as usize;
-            if use_bias {
-                Self::friction(&batch, &mut self.points[range.clone()], &mut a, &mut b);
-            }
             for p in &mut self.points[range.clone()] {
                 let d = (dx_b - dx_a) + (dr_b.mul_vec(p.r_b) - dr_a.mul_vec(p.r_a));
                 let s = batch.n.dot(d) + p.base;
