@@ -405,3 +405,38 @@ fn nan_born_mid_step_from_a_force_does_not_cross_the_contacts() {
     }
     assert_only_the_middle_box_is_quarantined(&w, &boxes);
 }
+
+#[test]
+fn a_box_spun_on_the_ground_stops_at_the_twist_friction_rate() {
+    // Twist friction about the normal is limited to μ ρ N, with ρ the contact points' mean
+    // distance from their centre: the four corners of a unit face, ρ = √2/2. The spin then
+    // falls at α = μ N ρ / I, I = m a²/6, and stops after t = ω₀ a² / (6 μ g ρ) = 0.240 s
+    // for ω₀ = 5 rad/s, μ = 0.5. (Uniform pressure over the face would give ρ = 0.383 a.)
+    let mut w = world(4);
+    scenes::ground(&mut w).unwrap();
+    let b = scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::new(0.0, 0.5, 0.0)).unwrap();
+    for _ in 0..30 {
+        w.step_physics();
+    }
+    let inertia = *w.get::<hooke::Inertia>(b).unwrap();
+    let q = w.get::<Rotation>(b).unwrap().0;
+    let omega0 = 5.0;
+    w.get_mut::<hooke::AngularMomentum>(b).unwrap().0 =
+        inertia.angular_momentum(q, glam::Vec3A::new(0.0, omega0, 0.0));
+    let expected = omega0 / (6.0 * 0.5 * G * std::f32::consts::FRAC_1_SQRT_2);
+    let mut stopped = None;
+    for step in 1..=60 {
+        w.step_physics();
+        let spin = w.get::<AngularVelocity>(b).unwrap().0.y;
+        if stopped.is_none() && spin.abs() < 0.01 {
+            stopped = Some(step as f32 / 60.0);
+        }
+    }
+    let t = stopped.expect("the box kept spinning");
+    println!("spin stopped after {t:.3} s (model {expected:.3} s)");
+    assert!(
+        (t - expected).abs() < 0.1 * expected + 1.0 / 60.0,
+        "{t} vs {expected}"
+    );
+    assert!(pos(&w, b).is_finite() && (pos(&w, b).y - 0.5).abs() < 0.01);
+}

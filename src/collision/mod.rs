@@ -19,8 +19,9 @@
 //! [`crate::StepSystems::RelaxConstraints`] solves once more without bias so that the
 //! push-out does not stay in the velocities. After the last substep, restitution brings the
 //! normal velocity of every contact that hit faster than [`ContactSettings::restitution_threshold`]
-//! to −e times its approach speed. Friction is Coulomb's, a cone clamped to μ times the
-//! normal impulse, solved in the relax pass. Each manifold keeps at most four points, and the
+//! to −e times its approach speed. Friction is Coulomb's, one 2D constraint per manifold at
+//! its centre clamped to μ times the manifold's normal impulse, plus a twist friction about
+//! the normal, solved in the relax pass. Each manifold keeps at most four points, and the
 //! solver takes four manifolds at a time in SIMD lanes (see the `solver` module). A
 //! separated contact (s > 0) is *speculative*: it only stops the approach
 //! from closing more than s in a substep, which is what keeps a fast small body from

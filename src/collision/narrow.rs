@@ -6,17 +6,24 @@ use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 use parry3d::query::{ContactManifold, ContactManifoldsWorkspace};
 
-/// What each contact point carries from step to step: the accumulated impulses, for warm
-/// starting. parry moves it to the matching point of the next step's manifold.
+/// What each contact point carries from step to step: its accumulated normal impulse, for
+/// warm starting. parry moves it to the matching point of the next step's manifold.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct ContactImpulse {
+pub(crate) struct ContactImpulse {
     /// Normal impulse (N·s).
     pub normal: f32,
-    /// Friction impulse (N·s, world frame).
-    pub tangent: Vec3,
 }
 
-pub(crate) type Manifold = ContactManifold<(), ContactImpulse>;
+/// What a manifold carries from step to step: its friction impulses, for warm starting.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct FrictionImpulse {
+    /// Friction impulse at the manifold's centre (N·s, world frame).
+    pub tangent: Vec3,
+    /// Twist impulse about the normal (N·m·s).
+    pub twist: f32,
+}
+
+pub(crate) type Manifold = ContactManifold<FrictionImpulse, ContactImpulse>;
 
 /// One pair's state.
 pub(crate) struct PairState {

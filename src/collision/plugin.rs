@@ -6,7 +6,7 @@ use parry3d::math::Pose;
 use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 
 use super::broad::{BroadPhase, Entry};
-use super::narrow::{ContactImpulse, Contacts, PairState, keep_points};
+use super::narrow::{ContactImpulse, Contacts, FrictionImpulse, PairState, keep_points};
 use super::solver::{
     BodyState, ContactSolver, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody,
 };
@@ -349,11 +349,8 @@ fn tangent_basis(
 ) -> [Vec3A; 2] {
     let count = m.points.len() as f32;
     let slide = count * ((vb + wb.cross(centre - xb)) - (va + wa.cross(centre - xa)));
-    let (mut impulse, mut normal) = (Vec3A::ZERO, 0.0f32);
-    for p in &m.points {
-        impulse += Vec3A::from(p.data.tangent);
-        normal += p.data.normal;
-    }
+    let impulse = Vec3A::from(m.data.tangent);
+    let normal: f32 = m.points.iter().map(|p| p.data.normal).sum();
     let along = |v: Vec3A| (v - n * n.dot(v)).try_normalize();
     // Only a clear signal picks the direction: below it (a body at rest under a small
     // sideways load) a noisy direction would turn the basis from step to step, and a fixed
@@ -422,21 +419,29 @@ fn prepare_contacts(
             let t = tangent_basis(n, m, centre, (a.0.0, va, wa), (b.0.0, vb, wb));
             let first = s.inputs.len() as u32;
             let (keep, count) = keep_points(world, n);
-            for &k in &keep[..count] {
+            let kept = &keep[..count];
+            // Friction acts at the kept points' centre; the twist's arm is their mean
+            // distance from it.
+            let middle = kept.iter().map(|&k| world[k].0).sum::<Vec3A>() / count as f32;
+            let radius = kept
+                .iter()
+                .map(|&k| (world[k].0 - middle).length())
+                .sum::<f32>()
+                / count as f32;
+            for &k in kept {
                 let (p, mid) = (&m.points[k], world[k].0);
                 let (r_a, r_b) = (mid - a.0.0, mid - b.0.0);
                 let rel = (vb + wb.cross(r_b)) - (va + wa.cross(r_a));
-                let tangent = Vec3A::from(p.data.tangent);
                 s.inputs.push(PointInput {
                     r_a,
                     r_b,
                     base: p.dist - n.dot(r_b - r_a),
                     n_imp: p.data.normal,
-                    t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
                     approach: n.dot(rel),
                     source: k as u32,
                 });
             }
+            let tangent = Vec3A::from(m.data.tangent);
             s.manifolds.push(ManifoldConstraint {
                 a: ia,
                 b: ib,
@@ -448,6 +453,11 @@ fn prepare_contacts(
                 count: s.inputs.len() as u32 - first,
                 pair: (ea, eb),
                 manifold: mi as u32,
+                centre_a: middle - a.0.0,
+                centre_b: middle - b.0.0,
+                radius,
+                t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
+                twist: m.data.twist,
             });
         }
     }
@@ -565,7 +575,7 @@ fn relax_contacts(
                 p.data = ContactImpulse::default();
             }
         }
-        for (mi, k, normal, tangent) in solver.impulses() {
+        for (mi, k, normal) in solver.impulses() {
             let m = &solver.manifolds[mi as usize];
             let tracked = contacts
                 .pairs
@@ -573,9 +583,19 @@ fn relax_contacts(
                 .and_then(|s| s.manifolds.get_mut(m.manifold as usize))
                 .and_then(|m| m.points.get_mut(k as usize));
             if let Some(tracked) = tracked {
-                tracked.data = ContactImpulse {
-                    normal,
+                tracked.data = ContactImpulse { normal };
+            }
+        }
+        for (mi, tangent, twist) in solver.frictions() {
+            let m = &solver.manifolds[mi as usize];
+            let tracked = contacts
+                .pairs
+                .get_mut(&m.pair)
+                .and_then(|s| s.manifolds.get_mut(m.manifold as usize));
+            if let Some(tracked) = tracked {
+                tracked.data = FrictionImpulse {
                     tangent: tangent.into(),
+                    twist,
                 };
             }
         }

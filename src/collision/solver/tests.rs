@@ -73,6 +73,11 @@ fn solver_with(bodies: usize, pairs: &[(u32, u32)]) -> ContactSolver {
             count: 1,
             pair: (Entity::PLACEHOLDER, Entity::PLACEHOLDER),
             manifold: 0,
+            centre_a: Vec3A::ZERO,
+            centre_b: Vec3A::ZERO,
+            radius: 0.0,
+            t_imp: [0.0; 2],
+            twist: 0.0,
         });
         s.inputs.push(PointInput {
             base: -0.01,
