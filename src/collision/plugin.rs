@@ -338,8 +338,9 @@ fn body_index(
 /// other through the body's rotation and their sum falls short of μN (measured: a box
 /// crept down a 30° slope at μ = 0.6).
 ///
-/// `centre` is the mean of the manifold's points: the mean relative velocity of the points
-/// is the relative velocity at their mean, since velocity is affine in position.
+/// `centre` is the mean of the solved points, where friction acts: the mean relative
+/// velocity of the points is the relative velocity at their mean (velocity is affine in
+/// position).
 fn tangent_basis(
     n: Vec3A,
     m: &super::narrow::Manifold,
@@ -347,8 +348,7 @@ fn tangent_basis(
     (xa, va, wa): (Vec3A, Vec3A, Vec3A),
     (xb, vb, wb): (Vec3A, Vec3A, Vec3A),
 ) -> [Vec3A; 2] {
-    let count = m.points.len() as f32;
-    let slide = count * ((vb + wb.cross(centre - xb)) - (va + wa.cross(centre - xa)));
+    let slide = (vb + wb.cross(centre - xb)) - (va + wa.cross(centre - xa));
     let impulse = Vec3A::from(m.data.tangent);
     let normal: f32 = m.points.iter().map(|p| p.data.normal).sum();
     let along = |v: Vec3A| (v - n * n.dot(v)).try_normalize();
@@ -356,7 +356,7 @@ fn tangent_basis(
     // sideways load) a noisy direction would turn the basis from step to step, and a fixed
     // basis is steadier.
     let t0 = along(slide)
-        .filter(|_| slide.length() > 1e-2 * m.points.len() as f32)
+        .filter(|_| slide.length() > 1e-2)
         .or_else(|| along(impulse).filter(|_| impulse.length() > 0.05 * normal))
         .unwrap_or_else(|| Vec3A::from(Vec3::from(n).any_orthonormal_pair().0));
     [t0, n.cross(t0)]
@@ -415,14 +415,13 @@ fn prepare_contacts(
                 let pb = Vec3A::from(pose_b * p.local_p2);
                 (0.5 * (pa + pb), p.dist, p.data != ContactImpulse::default())
             }));
-            let centre = world.iter().map(|w| w.0).sum::<Vec3A>() / world.len() as f32;
-            let t = tangent_basis(n, m, centre, (a.0.0, va, wa), (b.0.0, vb, wb));
             let first = s.inputs.len() as u32;
             let (keep, count) = keep_points(world, n);
             let kept = &keep[..count];
             // Friction acts at the kept points' centre; the twist's arm is their mean
             // distance from it.
             let middle = kept.iter().map(|&k| world[k].0).sum::<Vec3A>() / count as f32;
+            let t = tangent_basis(n, m, middle, (a.0.0, va, wa), (b.0.0, vb, wb));
             let radius = kept
                 .iter()
                 .map(|&k| (world[k].0 - middle).length())
@@ -565,39 +564,28 @@ fn relax_contacts(
     solver.solve(time.h, soft, fixed, false, settings.max_push_velocity);
     if time.is_last() {
         solver.restitution(settings.restitution_threshold);
-        // Points the solver left out (beyond four per manifold) start from zero if kept later.
-        for m in &solver.manifolds {
-            let tracked = contacts
-                .pairs
-                .get_mut(&m.pair)
-                .and_then(|s| s.manifolds.get_mut(m.manifold as usize));
-            for p in tracked.into_iter().flat_map(|m| &mut m.points) {
-                p.data = ContactImpulse::default();
-            }
-        }
-        for (mi, k, normal) in solver.impulses() {
-            let m = &solver.manifolds[mi as usize];
-            let tracked = contacts
+        for solved in solver.manifold_impulses() {
+            let m = solved.constraint;
+            let Some(tracked) = contacts
                 .pairs
                 .get_mut(&m.pair)
                 .and_then(|s| s.manifolds.get_mut(m.manifold as usize))
-                .and_then(|m| m.points.get_mut(k as usize));
-            if let Some(tracked) = tracked {
-                tracked.data = ContactImpulse { normal };
+            else {
+                continue;
+            };
+            // Points the solver left out (beyond four) start from zero if kept later.
+            for p in &mut tracked.points {
+                p.data = ContactImpulse::default();
             }
-        }
-        for (mi, tangent, twist) in solver.frictions() {
-            let m = &solver.manifolds[mi as usize];
-            let tracked = contacts
-                .pairs
-                .get_mut(&m.pair)
-                .and_then(|s| s.manifolds.get_mut(m.manifold as usize));
-            if let Some(tracked) = tracked {
-                tracked.data = FrictionImpulse {
-                    tangent: tangent.into(),
-                    twist,
-                };
+            for &(k, normal) in &solved.normals[..solved.count] {
+                if let Some(p) = tracked.points.get_mut(k as usize) {
+                    p.data = ContactImpulse { normal };
+                }
             }
+            tracked.data = FrictionImpulse {
+                tangent: solved.tangent.into(),
+                twist: solved.twist,
+            };
         }
     }
     scatter(&solver, &mut bodies);

@@ -626,41 +626,44 @@ impl ContactSolver {
         }
     }
 
-    /// The accumulated normal impulse of every point, for the next step's warm start:
-    /// manifold index, the point's index in the narrow phase's manifold, impulse.
-    pub fn impulses(&self) -> impl Iterator<Item = (u32, u32, f32)> + '_ {
-        self.batches.iter().flat_map(move |batch| {
-            let points = &self.points[batch.first as usize..(batch.first + batch.count) as usize];
-            (0..4)
-                .filter_map(move |l| {
-                    let mi = batch.lanes[l];
-                    self.manifolds.get(mi as usize).map(|m| (l, mi, m))
-                })
-                .flat_map(move |(l, mi, m)| {
-                    let sources = &self.inputs[m.first as usize..(m.first + m.count) as usize];
-                    points
-                        .iter()
-                        .zip(sources)
-                        .map(move |(p, input)| (mi, input.source, p.n_imp.to_array()[l]))
-                })
-        })
-    }
-
-    /// The accumulated friction of every manifold, for the next step's warm start: manifold
-    /// index, friction impulse at the centre (world frame) and twist impulse.
-    pub fn frictions(&self) -> impl Iterator<Item = (u32, Vec3A, f32)> + '_ {
+    /// Each manifold's accumulated impulses, for the next step's warm start: its
+    /// constraint, the normal impulse of each solved point (by its index in the narrow
+    /// phase's manifold), the friction impulse at its centre (world frame) and the twist.
+    pub fn manifold_impulses(&self) -> impl Iterator<Item = SolvedManifold<'_>> + '_ {
         self.batches
             .iter()
             .zip(&self.friction)
             .flat_map(move |(batch, f)| {
+                let points =
+                    &self.points[batch.first as usize..(batch.first + batch.count) as usize];
                 (0..4).filter_map(move |l| {
-                    let mi = batch.lanes[l];
-                    let m = self.manifolds.get(mi as usize)?;
+                    let m = self.manifolds.get(batch.lanes[l] as usize)?;
+                    let inputs = &self.inputs[m.first as usize..(m.first + m.count) as usize];
+                    let mut normals = [(0, 0.0); super::narrow::MAX_POINTS];
+                    for ((slot, p), input) in normals.iter_mut().zip(points).zip(inputs) {
+                        *slot = (input.source, p.n_imp.to_array()[l]);
+                    }
                     let (t, twist) = f.lane(l);
-                    Some((mi, t[0] * m.t[0] + t[1] * m.t[1], twist))
+                    Some(SolvedManifold {
+                        constraint: m,
+                        normals,
+                        count: inputs.len(),
+                        tangent: t[0] * m.t[0] + t[1] * m.t[1],
+                        twist,
+                    })
                 })
             })
     }
+}
+
+/// One manifold's impulses after the step (see [`ContactSolver::manifold_impulses`]).
+pub(crate) struct SolvedManifold<'a> {
+    pub constraint: &'a ManifoldConstraint,
+    /// (point index in the narrow phase's manifold, normal impulse); the first `count`.
+    pub normals: [(u32, f32); super::narrow::MAX_POINTS],
+    pub count: usize,
+    pub tangent: Vec3A,
+    pub twist: f32,
 }
 
 mod friction;
