@@ -15,6 +15,7 @@ use parry3d::bounding_volume::Aabb;
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
 
 use super::CollisionLayers;
+use super::lanes::F4;
 
 /// One collider's box as the broad phase sees it.
 #[derive(Debug, Clone, Copy)]
@@ -42,6 +43,50 @@ pub(crate) struct BroadPhase {
     pub axis: usize,
     /// Candidate pairs (lower entity first), sorted.
     pub pairs: Vec<(Entity, Entity)>,
+    /// The moving boxes in sweep order as six coordinate arrays, padded with empty boxes to
+    /// whole lanes: the sweep tests four candidates at once.
+    sweep: Sweep,
+}
+
+/// Structure-of-arrays copy of the sorted moving boxes.
+#[derive(Debug, Default)]
+struct Sweep {
+    min: [Vec<f32>; 3],
+    max: [Vec<f32>; 3],
+}
+
+impl Sweep {
+    fn fill(&mut self, entries: &[Entry]) {
+        for k in 0..3 {
+            let (min, max) = (&mut self.min[k], &mut self.max[k]);
+            min.clear();
+            max.clear();
+            min.extend(entries.iter().map(|e| e.min[k]));
+            max.extend(entries.iter().map(|e| e.max[k]));
+            // An empty box (min > max) past the end: never overlaps, ends every sweep.
+            min.extend([f32::INFINITY; 4]);
+            max.extend([f32::NEG_INFINITY; 4]);
+        }
+    }
+
+    #[inline]
+    fn lanes(v: &[f32], j: usize) -> F4 {
+        // One bounds check and one unaligned load (the sweep never reads past the padding).
+        let four: [f32; 4] = v[j..j + 4].try_into().unwrap_or([f32::NAN; 4]);
+        F4::new(four)
+    }
+
+    /// Bit l set when box j + l overlaps box i.
+    #[inline]
+    fn overlaps(&self, i: usize, j: usize) -> u32 {
+        let mut hit = F4::splat(0.0).simd_eq(F4::splat(0.0));
+        for k in 0..3 {
+            let (amin, amax) = (F4::splat(self.min[k][i]), F4::splat(self.max[k][i]));
+            hit &= Self::lanes(&self.min[k], j).simd_le(amax)
+                & Self::lanes(&self.max[k], j).simd_ge(amin);
+        }
+        hit.to_bitmask()
+    }
 }
 
 impl Default for BroadPhase {
@@ -55,6 +100,7 @@ impl Default for BroadPhase {
             moving_dirty: true,
             axis: 0,
             pairs: Vec::new(),
+            sweep: Sweep::default(),
         }
     }
 }
@@ -97,10 +143,6 @@ fn key(a: Entity, b: Entity) -> (Entity, Entity) {
     if a < b { (a, b) } else { (b, a) }
 }
 
-fn overlap(a: &Entry, b: &Entry) -> bool {
-    a.min.cmple(b.max).all() && b.min.cmple(a.max).all()
-}
-
 impl BroadPhase {
     /// Rebuilds the fixed tree from `self.fixed` if it is out of date.
     pub fn refresh_fixed(&mut self) {
@@ -141,14 +183,22 @@ impl BroadPhase {
         }
         self.pairs.clear();
         let axis = self.axis;
+        self.sweep.fill(&self.moving);
+        let keys = &self.sweep.min[axis];
         for (i, a) in self.moving.iter().enumerate() {
-            for b in &self.moving[i + 1..] {
-                if b.min[axis] > a.max[axis] {
-                    break;
+            let end = a.max[axis];
+            let mut j = i + 1;
+            // The padding's infinite keys stop the loop within the arrays.
+            while keys[j] <= end {
+                let mut hits = self.sweep.overlaps(i, j);
+                while hits != 0 {
+                    let b = &self.moving[j + hits.trailing_zeros() as usize];
+                    hits &= hits - 1;
+                    if (a.awake || b.awake) && a.layers.interacts(b.layers) {
+                        self.pairs.push(key(a.entity, b.entity));
+                    }
                 }
-                if (a.awake || b.awake) && overlap(a, b) && a.layers.interacts(b.layers) {
-                    self.pairs.push(key(a.entity, b.entity));
-                }
+                j += 4;
             }
         }
         self.refresh_fixed();

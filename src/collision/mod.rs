@@ -34,6 +34,7 @@
 //! Units: m, s, kg; impulses in N·s.
 
 mod broad;
+mod exchange;
 mod lanes;
 mod narrow;
 mod plugin;

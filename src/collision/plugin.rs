@@ -6,10 +6,9 @@ use parry3d::math::Pose;
 use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 
 use super::broad::{BroadPhase, Entry};
+use super::exchange::{SolvedBody, gather, scatter};
 use super::narrow::{ContactImpulse, Contacts, FrictionImpulse, PairState, keep_points};
-use super::solver::{
-    BodyState, ContactSolver, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody,
-};
+use super::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody};
 use super::{
     Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted,
     Friction, Restitution, Sensor,
@@ -18,7 +17,7 @@ use crate::Plugin;
 use crate::integrator::ConstraintsActive;
 use crate::particles::{LinearVelocity, Mass, Position};
 use crate::quarantine::Quarantined;
-use crate::rigid::{AngularMomentum, AngularVelocity, CenterOfMass, Inertia, Rotation};
+use crate::rigid::{AngularVelocity, CenterOfMass, Inertia, Rotation};
 use crate::schedule::{PhysicsSchedule, PrepareSystems, StepSystems, SubstepSchedule, add_systems};
 use crate::sleep::Sleeping;
 use crate::time::{PhysicsTime, SubstepTime};
@@ -295,7 +294,7 @@ fn body_index(
     e: Entity,
     b: &bevy_ecs::query::QueryItem<'_, '_, PreparedBody<'_>>,
 ) -> u32 {
-    if let Some(&i) = solver.index.get(&e) {
+    if let Some(i) = solver.index.get(e, &solver.bodies) {
         return i;
     }
     let (x, q, _, mass, v, inertia, w, _, _, sleeping) = *b;
@@ -464,68 +463,6 @@ fn prepare_contacts(
     active.0 = !s.manifolds.is_empty();
 }
 
-type SolvedBody<'a> = (
-    &'a Position,
-    &'a Rotation,
-    &'a mut LinearVelocity,
-    Option<&'a mut AngularMomentum>,
-    Option<&'a AngularVelocity>,
-);
-
-/// Reads the current state of every body in contact into the solver.
-fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
-    let mut frozen = Vec::new();
-    for (i, b) in solver.bodies.iter_mut().enumerate() {
-        let Ok((x, q, v, l, w)) = bodies.get(b.entity) else {
-            continue;
-        };
-        let dr = Mat3A::from_quat(q.0 * b.q0.inverse());
-        // ω = I(q)⁻¹ L, with I(q)⁻¹ = ΔR I₀⁻¹ ΔRᵀ: three matrix products instead of the
-        // quaternion round trip through the principal frame.
-        let w = match l {
-            Some(l) if b.dynamic => dr * (b.inv_i * (dr.transpose() * l.0)),
-            _ => w.map_or(Vec3A::ZERO, |w| w.0),
-        };
-        let state = BodyState {
-            v: v.0,
-            w,
-            dx: x.0 - b.x0,
-            dr,
-        };
-        b.w_in = w;
-        let finite =
-            state.v.is_finite() && w.is_finite() && state.dx.is_finite() && q.0.is_finite();
-        if finite || !b.dynamic {
-            solver.states[i] = if finite { state } else { BodyState::REST };
-        } else {
-            // A body that turned non-finite inside the step (it is quarantined at the next
-            // position pass) must not pass NaN through its contacts: for the rest of the
-            // step it is an immovable, motionless obstacle and is never written back.
-            solver.states[i] = BodyState::REST;
-            frozen.push(i as u32);
-        }
-    }
-    for i in frozen {
-        solver.freeze(i);
-    }
-}
-
-/// Writes the solved velocities back: v directly, and L += I₀ Δω, the angular impulse of
-/// the pass (the solver moved ω by I₀⁻¹ Σ r × P with the step's start inertia I₀).
-fn scatter(solver: &ContactSolver, bodies: &mut Query<SolvedBody, Live>) {
-    for (b, state) in solver.bodies.iter().zip(&solver.states) {
-        if !b.dynamic {
-            continue;
-        }
-        if let Ok((_, _, mut v, l, _)) = bodies.get_mut(b.entity) {
-            v.0 = state.v;
-            if let Some(mut l) = l {
-                l.bypass_change_detection().0 += b.i0 * (state.w - b.w_in);
-            }
-        }
-    }
-}
-
 fn softness(settings: &ContactSettings, h: f32) -> (Softness, Softness) {
     // An eighth of the substep rate, not Box2D's quarter: at a quarter (60 Hz with 4 substeps
     // of 60 Hz) a 20-row pyramid crept 8–16 cm in 10 s; at an eighth it holds (measured).
@@ -547,7 +484,7 @@ fn solve_contacts(
     let (soft, fixed) = softness(&settings, time.h);
     solver.warm_start();
     solver.solve(time.h, soft, fixed, true, settings.max_push_velocity);
-    scatter(&solver, &mut bodies);
+    scatter(&mut solver, &mut bodies);
 }
 
 /// One pass without bias; after the last substep, restitution and the impulses kept for
@@ -588,5 +525,5 @@ fn relax_contacts(
             };
         }
     }
-    scatter(&solver, &mut bodies);
+    scatter(&mut solver, &mut bodies);
 }

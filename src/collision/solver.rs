@@ -23,8 +23,6 @@
 //! batch, after the colours. The order is fixed by the order of the manifolds, so results
 //! are bit-identical from run to run.
 
-use bevy_platform::collections::HashMap;
-
 use bevy_ecs::prelude::*;
 use glam::{Mat3A, Quat, Vec3A};
 
@@ -190,7 +188,9 @@ pub(crate) struct ContactSolver {
     pub states: Vec<BodyState>,
     pub manifolds: Vec<ManifoldConstraint>,
     pub inputs: Vec<PointInput>,
-    pub index: HashMap<Entity, u32>,
+    pub index: BodyMap,
+    /// Where the bodies sit in the ECS storage order (see [`super::exchange`]).
+    pub order: super::exchange::StorageOrder,
     batches: Vec<Batch>,
     points: Vec<Point>,
     /// Per batch: its manifolds' friction.
@@ -198,6 +198,42 @@ pub(crate) struct ContactSolver {
     /// Colouring scratch, kept to reuse its memory.
     colours: Vec<Vec<u32>>,
     used: Vec<u64>,
+}
+
+/// Solver index per entity, kept in an array by the entity's index (a lookup is a load and
+/// a generation check, not a hash).
+#[derive(Debug, Default)]
+pub(crate) struct BodyMap {
+    slots: Vec<u32>,
+}
+
+impl BodyMap {
+    /// The solver index of `e`, if it has one this step.
+    #[inline]
+    pub fn get(&self, e: Entity, bodies: &[SolverBody]) -> Option<u32> {
+        let i = *self.slots.get(e.index_u32() as usize)?;
+        bodies
+            .get(i as usize)
+            .is_some_and(|b| b.entity == e)
+            .then_some(i)
+    }
+
+    pub fn insert(&mut self, e: Entity, i: u32) {
+        let k = e.index_u32() as usize;
+        if k >= self.slots.len() {
+            self.slots.resize(k + 1, FIXED);
+        }
+        self.slots[k] = i;
+    }
+
+    /// Empties the map of the step's `bodies`.
+    fn clear(&mut self, bodies: &[SolverBody]) {
+        for b in bodies {
+            if let Some(slot) = self.slots.get_mut(b.entity.index_u32() as usize) {
+                *slot = FIXED;
+            }
+        }
+    }
 }
 
 /// The soft-constraint coefficients for frequency `hertz`, damping ratio `zeta` and step `h`.
@@ -277,11 +313,12 @@ impl Side {
 impl ContactSolver {
     /// Empties the solver for a new step.
     pub fn clear(&mut self) {
+        self.index.clear(&self.bodies);
         self.bodies.clear();
         self.states.clear();
         self.manifolds.clear();
         self.inputs.clear();
-        self.index.clear();
+        self.order.reset();
         self.batches.clear();
         self.points.clear();
         self.friction.clear();

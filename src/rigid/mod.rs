@@ -27,7 +27,8 @@
 //! ω = I(q)⁻¹L at the start orientation, and on an asymmetric body that pumps energy in: a
 //! spin about the major axis creeps towards the minor axis. The default is therefore a
 //! free-rotation splitting ([`free_rotation_split`]): symplectic, |L| exact, energy error
-//! bounded. RK4 integrates q as a 4-vector with the derivative ½ ω ⊗ q at each stage. The
+//! bounded. A body with three equal moments (a sphere, a cube) has constant ω = L/I, and the
+//! splitting takes the exact single turn exp(½ h ω) for it. RK4 integrates q as a 4-vector with the derivative ½ ω ⊗ q at each stage. The
 //! [`StepSystems::Renormalize`](crate::StepSystems::Renormalize) set renormalises q every
 //! substep unless [`Renormalization`] is off (to show its effect) or a body has
 //! [`SkipRenormalization`].
@@ -415,10 +416,17 @@ pub fn integrate_rotation(q: Quat, omega: Vec3A, h: f32, update: OrientationUpda
 
 /// The free-rotation splitting step for a body with world angular momentum `l` held over
 /// `h`: exact spins about the principal axes in the order 1, 2, 3 (`strang == false`, first
-/// order) or ½1, ½2, 3, ½2, ½1 (`strang == true`, second order).
+/// order) or ½1, ½2, 3, ½2, ½1 (`strang == true`, second order). With three equal moments
+/// ω = L/I is constant and the step is the exact turn exp(½ h ω) ⊗ q instead.
 #[must_use]
 #[inline]
 pub fn free_rotation_split(q: Quat, inertia: &Inertia, l: Vec3A, h: f32, strang: bool) -> Quat {
+    let inv = inertia.inverse;
+    if inv.x == inv.y && inv.y == inv.z {
+        // Equal moments (a sphere, a cube): ω = L/I is constant, and the exact flow is one
+        // turn by h ω, which both splittings only approximate.
+        return Quat::from_scaled_axis((l * (inv.x * h)).into()) * unit(q);
+    }
     // p maps the principal frame to the world; each sub-flow turns it about one of its own
     // axes (right multiplication) at the rate L_body,i / I_i, which leaves world L fixed.
     let mut p = unit(q) * inertia.frame;

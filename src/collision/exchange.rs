@@ -1,0 +1,332 @@
+//! Moving body state between the ECS and the contact solver: a gather before and a scatter
+//! after each of the two solver passes of a substep.
+//!
+//! A gather reads x, q, v and L and forms ω = ΔR I₀⁻¹ ΔRᵀ L (I(q)⁻¹ = ΔR I₀⁻¹ ΔRᵀ: three
+//! matrix products instead of the quaternion round trip through the principal frame). A
+//! scatter writes v and L += I₀ Δω, the angular impulse of the pass (the solver moved ω by
+//! I₀⁻¹ Σ r × P with the step's start inertia I₀).
+//!
+//! **Storage order.** Looking each body up by entity costs about as much as the solver's
+//! arithmetic for it. So the first gather of a step records at which position of the
+//! query's storage-order walk each solver body sits, and every pass walks the query once,
+//! checking each entity against the record. A body whose position changed (a structural
+//! change between substeps, such as a quarantine) fails the check and is looked up by
+//! entity instead, and the record is rebuilt at the next gather. A world where the solver's
+//! bodies are a small part of the query keeps the lookups, so a few contacts among many
+//! free bodies do not pay for a walk over all of them.
+
+use bevy_ecs::prelude::*;
+use glam::{Mat3A, Vec3A};
+
+use super::solver::{BodyState, ContactSolver};
+use crate::particles::{LinearVelocity, Position};
+use crate::quarantine::Quarantined;
+use crate::rigid::{AngularMomentum, AngularVelocity, Rotation};
+
+/// A query position that holds no solver body.
+const NONE: u32 = u32::MAX;
+
+/// A walk pays while at least this share of the query's bodies are in the solver.
+const WALK_SHARE: usize = 4;
+
+pub(super) type SolvedBody<'a> = (
+    Entity,
+    &'a Position,
+    &'a Rotation,
+    &'a mut LinearVelocity,
+    Option<&'a mut AngularMomentum>,
+    Option<&'a AngularVelocity>,
+);
+
+pub(super) type Live = Without<Quarantined>;
+
+/// Where each solver body sits in the query's storage order, for one step.
+#[derive(Debug, Default)]
+pub(crate) struct StorageOrder {
+    /// Per query position, the solver body there, or [`NONE`].
+    slots: Vec<u32>,
+    /// Per solver body, the pass that last reached it.
+    reached: Vec<u32>,
+    pass: u32,
+    /// False until the step's first gather, and after a walk missed a body.
+    ready: bool,
+    /// Whether passes walk the query (else they look bodies up).
+    walk: bool,
+}
+
+impl StorageOrder {
+    /// Forgets the record: the solver's bodies changed.
+    pub fn reset(&mut self) {
+        self.ready = false;
+        self.reached.clear();
+    }
+
+    fn begin(&mut self, solver_bodies: usize) -> u32 {
+        self.pass = self.pass.wrapping_add(1);
+        if self.pass == 0 {
+            // Never equal to a stamp of an old pass after wrapping.
+            self.reached.fill(0);
+            self.pass = 1;
+        }
+        self.reached.resize(solver_bodies, 0);
+        self.pass
+    }
+}
+
+fn record(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
+    let order = &mut solver.order;
+    order.ready = true;
+    order.slots.clear();
+    let len = bodies.iter().len();
+    order.walk = len <= WALK_SHARE * solver.bodies.len();
+    if order.walk {
+        order.slots.extend(
+            bodies
+                .iter()
+                .map(|item| solver.index.get(item.0, &solver.bodies).unwrap_or(NONE)),
+        );
+    }
+}
+
+/// Reads the current state of every body in contact into the solver.
+pub(super) fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
+    if !solver.order.ready {
+        record(solver, bodies);
+    }
+    let pass = solver.order.begin(solver.bodies.len());
+    let mut frozen = Vec::new();
+    if solver.order.walk {
+        let slots = std::mem::take(&mut solver.order.slots);
+        // `for_each` takes the query's table-at-a-time fold; a `zip` would not.
+        bodies.iter().enumerate().for_each(|(k, item)| {
+            let slot = slots.get(k).copied().unwrap_or(NONE);
+            if slot != NONE && solver.bodies[slot as usize].entity == item.0 {
+                read(solver, slot as usize, item, &mut frozen);
+                solver.order.reached[slot as usize] = pass;
+            }
+        });
+        solver.order.slots = slots;
+    }
+    for i in 0..solver.bodies.len() {
+        if solver.order.reached[i] != pass
+            && let Ok(item) = bodies.get(solver.bodies[i].entity)
+        {
+            // Present but elsewhere: the storage changed, record it again next time.
+            solver.order.ready &= !solver.order.walk;
+            read(solver, i, item, &mut frozen);
+        }
+    }
+    for i in frozen {
+        solver.freeze(i);
+    }
+}
+
+#[inline]
+fn read(
+    solver: &mut ContactSolver,
+    i: usize,
+    (_, x, q, v, l, w): bevy_ecs::query::ROQueryItem<'_, '_, SolvedBody<'_>>,
+    frozen: &mut Vec<u32>,
+) {
+    let b = &mut solver.bodies[i];
+    let dr = Mat3A::from_quat(q.0 * b.q0.inverse());
+    let w = match l {
+        Some(l) if b.dynamic => dr * (b.inv_i * (dr.transpose() * l.0)),
+        _ => w.map_or(Vec3A::ZERO, |w| w.0),
+    };
+    let state = BodyState {
+        v: v.0,
+        w,
+        dx: x.0 - b.x0,
+        dr,
+    };
+    b.w_in = w;
+    let finite = state.v.is_finite() && w.is_finite() && state.dx.is_finite() && q.0.is_finite();
+    if finite || !b.dynamic {
+        solver.states[i] = if finite { state } else { BodyState::REST };
+    } else {
+        // A body that turned non-finite inside the step (it is quarantined at the next
+        // position pass) must not pass NaN through its contacts: for the rest of the step
+        // it is an immovable, motionless obstacle and is never written back.
+        solver.states[i] = BodyState::REST;
+        frozen.push(i as u32);
+    }
+}
+
+/// Writes the solved velocities back.
+pub(super) fn scatter(solver: &mut ContactSolver, bodies: &mut Query<SolvedBody, Live>) {
+    let pass = solver.order.begin(solver.bodies.len());
+    if solver.order.walk && solver.order.ready {
+        let slots = std::mem::take(&mut solver.order.slots);
+        bodies.iter_mut().enumerate().for_each(|(k, item)| {
+            let slot = slots.get(k).copied().unwrap_or(NONE);
+            if slot != NONE && solver.bodies[slot as usize].entity == item.0 {
+                write(solver, slot as usize, item);
+                solver.order.reached[slot as usize] = pass;
+            }
+        });
+        solver.order.slots = slots;
+    }
+    for i in 0..solver.bodies.len() {
+        if solver.order.reached[i] != pass
+            && let Ok(item) = bodies.get_mut(solver.bodies[i].entity)
+        {
+            solver.order.ready &= !solver.order.walk;
+            write(solver, i, item);
+        }
+    }
+}
+
+#[inline]
+fn write(
+    solver: &ContactSolver,
+    i: usize,
+    (_, _, _, mut v, l, _): bevy_ecs::query::QueryItem<'_, '_, SolvedBody<'_>>,
+) {
+    let (b, state) = (&solver.bodies[i], &solver.states[i]);
+    if !b.dynamic {
+        return;
+    }
+    v.0 = state.v;
+    if let Some(mut l) = l {
+        l.bypass_change_detection().0 += b.i0 * (state.w - b.w_in);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::collision::solver::SolverBody;
+    use bevy_ecs::system::SystemState;
+    use glam::{Quat, Vec3};
+
+    type Params = (
+        ResMut<'static, ContactSolver>,
+        Query<'static, 'static, SolvedBody<'static>, Live>,
+    );
+
+    fn body(world: &mut World, i: usize) -> Entity {
+        world
+            .spawn((
+                Position::from(Vec3::new(i as f32, 0.0, 0.0)),
+                Rotation(Quat::IDENTITY),
+                LinearVelocity::from(Vec3::new(i as f32, 0.0, 0.0)),
+                AngularMomentum::from(Vec3::ZERO),
+                AngularVelocity::from(Vec3::ZERO),
+            ))
+            .id()
+    }
+
+    /// A world of six bodies; the solver holds the last four (unit mass and inertia).
+    fn setup() -> (World, Vec<Entity>) {
+        let mut world = World::new();
+        let entities: Vec<Entity> = (0..6).map(|i| body(&mut world, i)).collect();
+        let mut solver = ContactSolver::default();
+        for &e in &entities[2..] {
+            let i = solver.bodies.len() as u32;
+            solver.bodies.push(SolverBody {
+                entity: e,
+                inv_mass: 1.0,
+                inv_i: Mat3A::IDENTITY,
+                i0: Mat3A::IDENTITY,
+                x0: Vec3A::ZERO,
+                q0: Quat::IDENTITY,
+                w_in: Vec3A::ZERO,
+                dynamic: true,
+            });
+            solver.index.insert(e, i);
+        }
+        solver.states = vec![BodyState::REST; solver.bodies.len() + 1];
+        world.insert_resource(solver);
+        (world, entities)
+    }
+
+    fn gather_in(world: &mut World, state: &mut SystemState<Params>) {
+        let (mut solver, bodies) = state.get_mut(world).expect("the test world has the solver");
+        gather(&mut solver, &bodies);
+    }
+
+    fn scatter_in(world: &mut World, state: &mut SystemState<Params>) {
+        let (mut solver, mut bodies) = state.get_mut(world).expect("the test world has the solver");
+        scatter(&mut solver, &mut bodies);
+    }
+
+    fn velocities(world: &World) -> Vec<f32> {
+        let solver = world.resource::<ContactSolver>();
+        solver.states[..solver.bodies.len()]
+            .iter()
+            .map(|s| s.v.x)
+            .collect()
+    }
+
+    #[test]
+    fn passes_follow_the_bodies_when_the_storage_order_changes_between_them() {
+        let (mut world, e) = setup();
+        let mut state = SystemState::<Params>::new(&mut world);
+        gather_in(&mut world, &mut state);
+        assert!(world.resource::<ContactSolver>().order.walk);
+        assert_eq!(velocities(&world), [2.0, 3.0, 4.0, 5.0]);
+
+        // Removing the first body moves the last one into its row: every solver body but
+        // one now sits elsewhere in the walk.
+        world.despawn(e[0]);
+        for (k, &b) in e[2..].iter().enumerate() {
+            world.get_mut::<LinearVelocity>(b).unwrap().0 = Vec3A::splat(10.0 * k as f32);
+        }
+        gather_in(&mut world, &mut state);
+        assert_eq!(velocities(&world), [0.0, 10.0, 20.0, 30.0]);
+        assert!(!world.resource::<ContactSolver>().order.ready);
+
+        // The scatter after a missed walk writes each body exactly once: L += I₀ Δω.
+        {
+            let mut solver = world.resource_mut::<ContactSolver>();
+            for s in &mut solver.states[..4] {
+                s.v = Vec3A::new(-1.0, 0.0, 0.0);
+                s.w = Vec3A::new(0.0, 2.0, 0.0);
+            }
+        }
+        scatter_in(&mut world, &mut state);
+        for &b in &e[2..] {
+            assert_eq!(world.get::<LinearVelocity>(b).unwrap().0.x, -1.0);
+            assert_eq!(world.get::<AngularMomentum>(b).unwrap().0.y, 2.0);
+        }
+
+        // The next gather records the new order and walks it again.
+        gather_in(&mut world, &mut state);
+        assert!(world.resource::<ContactSolver>().order.ready);
+        assert_eq!(velocities(&world), [-1.0; 4]);
+        scatter_in(&mut world, &mut state);
+        for &b in &e[2..] {
+            // ω read back as 2 (unit inertia), written unchanged: L stays 2.
+            assert_eq!(world.get::<AngularMomentum>(b).unwrap().0.y, 2.0);
+        }
+    }
+
+    #[test]
+    fn a_few_solver_bodies_among_many_are_looked_up_not_walked() {
+        let mut world = World::new();
+        for i in 0..40 {
+            body(&mut world, i);
+        }
+        let e = body(&mut world, 99);
+        let mut solver = ContactSolver::default();
+        solver.bodies.push(SolverBody {
+            entity: e,
+            inv_mass: 1.0,
+            inv_i: Mat3A::IDENTITY,
+            i0: Mat3A::IDENTITY,
+            x0: Vec3A::ZERO,
+            q0: Quat::IDENTITY,
+            w_in: Vec3A::ZERO,
+            dynamic: true,
+        });
+        solver.index.insert(e, 0);
+        solver.states = vec![BodyState::REST; 2];
+        world.insert_resource(solver);
+        let mut state = SystemState::<Params>::new(&mut world);
+        gather_in(&mut world, &mut state);
+        let solver = world.resource::<ContactSolver>();
+        assert!(!solver.order.walk);
+        assert_eq!(solver.states[0].v.x, 99.0);
+    }
+}
