@@ -23,19 +23,17 @@ impl V3 {
     #[inline]
     #[must_use]
     pub fn from_lanes(v: [Vec3A; 4]) -> Self {
-        Self {
-            x: F4::new([v[0].x, v[1].x, v[2].x, v[3].x]),
-            y: F4::new([v[0].y, v[1].y, v[2].y, v[3].y]),
-            z: F4::new([v[0].z, v[1].z, v[2].z, v[3].z]),
-        }
+        // A 4×4 register transpose (the fourth component is padding).
+        let [x, y, z, _] = F4::transpose(v.map(|v| F4::new(v.extend(0.0).to_array())));
+        Self { x, y, z }
     }
 
     /// The four vectors, lane by lane.
     #[inline]
     #[must_use]
     pub fn lanes(self) -> [Vec3A; 4] {
-        let (x, y, z) = (self.x.to_array(), self.y.to_array(), self.z.to_array());
-        std::array::from_fn(|i| Vec3A::new(x[i], y[i], z[i]))
+        let t = F4::transpose([self.x, self.y, self.z, F4::ZERO]);
+        t.map(|l| Vec3A::from_vec4(glam::Vec4::from_array(l.to_array())))
     }
 
     #[inline]
@@ -140,6 +138,17 @@ impl M3 {
     #[must_use]
     pub fn mul_vec(&self, v: V3) -> V3 {
         v.x * self.cols[0] + v.y * self.cols[1] + v.z * self.cols[2]
+    }
+
+    /// Mᵀ v, lane by lane.
+    #[inline]
+    #[must_use]
+    pub fn transpose_mul_vec(&self, v: V3) -> V3 {
+        V3 {
+            x: self.cols[0].dot(v),
+            y: self.cols[1].dot(v),
+            z: self.cols[2].dot(v),
+        }
     }
 }
 

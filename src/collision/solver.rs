@@ -598,10 +598,15 @@ impl ContactSolver {
             } else {
                 (zero, one, zero)
             };
+            // n·(ΔR r) = (ΔRᵀ n)·r: one matrix product per side per batch, not per point.
+            let (turn_a, turn_b) = (
+                dr_a.transpose_mul_vec(batch.n),
+                dr_b.transpose_mul_vec(batch.n),
+            );
+            let shift = batch.n.dot(dx_b - dx_a);
             let range = batch.first as usize..(batch.first + batch.count) as usize;
             for p in &mut self.points[range.clone()] {
-                let d = (dx_b - dx_a) + (dr_b.mul_vec(p.r_b) - dr_a.mul_vec(p.r_a));
-                let s = batch.n.dot(d) + p.base;
+                let s = (shift + (turn_b.dot(p.r_b) - turn_a.dot(p.r_a))) + p.base;
                 let speculative = s.simd_gt(zero);
                 let bias = speculative.select(s * inv_h, (bias_rate * s).fast_max(max_push));
                 let m_scale = speculative.select(one, mass_scale);
