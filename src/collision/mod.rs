@@ -72,6 +72,8 @@ use crate::rigid::Rotation;
 #[component(on_insert = collider_changed, on_remove = collider_changed)]
 pub struct Collider {
     shape: SharedShape,
+    /// The shape's local bounding box, kept: the contact systems read it every step.
+    bounds: [Vec3; 2],
 }
 
 impl std::fmt::Debug for Collider {
@@ -96,7 +98,16 @@ impl Collider {
         let aabb = shape.compute_local_aabb();
         finite_vec("collider bounds", aabb.mins)?;
         finite_vec("collider bounds", aabb.maxs)?;
-        Ok(Self { shape })
+        Ok(Self {
+            shape,
+            bounds: [aabb.mins, aabb.maxs],
+        })
+    }
+
+    /// Lower and upper corners of the shape's bounding box in its own frame (m).
+    #[must_use]
+    pub(crate) fn local_bounds(&self) -> [Vec3; 2] {
+        self.bounds
     }
 
     /// A ball of radius `r` (m).

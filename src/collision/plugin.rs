@@ -79,9 +79,9 @@ fn shape_pose(x: Vec3A, q: Quat, com: Option<&CenterOfMass>) -> Pose {
 
 /// Bounding radius of a shape about the centre of mass (m).
 fn radius(collider: &Collider, com: Option<&CenterOfMass>) -> f32 {
-    let aabb = collider.shape().compute_local_aabb();
+    let [min, max] = collider.local_bounds();
     let c = com.map_or(Vec3::ZERO, |c| c.0);
-    (aabb.mins - c).length().max((aabb.maxs - c).length())
+    (min - c).length().max((max - c).length())
 }
 
 type MovingCollider<'a> = (

@@ -255,8 +255,20 @@ impl Inertia {
     pub fn angular_velocity(&self, q: Quat, l: Vec3A) -> Vec3A {
         // Rotating by a non-unit quaternion scales by |q|², and q is not unit between a
         // first-order update and the renormalise set (or when that is off).
+        if self.is_isotropic() {
+            return self.inverse.x * l;
+        }
         let qf = unit(q) * self.frame;
         qf * (self.inverse * (qf.inverse() * l))
+    }
+
+    /// True when the three principal moments are equal (a sphere, a cube): then I is a
+    /// multiple of the identity in every frame.
+    #[must_use]
+    #[inline]
+    pub fn is_isotropic(&self) -> bool {
+        let d = self.principal;
+        d.x == d.y && d.y == d.z
     }
 
     /// L = I ω with I = R I₀ Rᵀ, for orientation `q` (zero for infinite inertia, which keeps
@@ -266,6 +278,9 @@ impl Inertia {
     pub fn angular_momentum(&self, q: Quat, omega: Vec3A) -> Vec3A {
         if self.is_infinite() {
             return Vec3A::ZERO;
+        }
+        if self.is_isotropic() {
+            return self.principal.x * omega;
         }
         let qf = unit(q) * self.frame;
         qf * (self.principal * (qf.inverse() * omega))
@@ -422,7 +437,7 @@ pub fn integrate_rotation(q: Quat, omega: Vec3A, h: f32, update: OrientationUpda
 #[inline]
 pub fn free_rotation_split(q: Quat, inertia: &Inertia, l: Vec3A, h: f32, strang: bool) -> Quat {
     let inv = inertia.inverse;
-    if inv.x == inv.y && inv.y == inv.z {
+    if inertia.is_isotropic() {
         // Equal moments (a sphere, a cube): ω = L/I is constant, and the exact flow is one
         // turn by h ω, which both splittings only approximate.
         return Quat::from_scaled_axis((l * (inv.x * h)).into()) * unit(q);
