@@ -179,7 +179,7 @@ fn contact_events_start_and_end_once_each() {
 #[test]
 fn heavy_box_on_light_box_at_1_to_100_stays_stable() {
     // 8 substeps: at the default 4 the pair stays bounded (15 s measured) but compresses
-    // 57 mm under the 30 Hz contacts and keeps a 3–11 cm/s jitter; at 8 it comes to rest.
+    // 57 mm under the 30 Hz contacts and keeps a 1–12 cm/s jitter; at 8 it comes to rest.
     let mut w = world(8);
     scenes::ground(&mut w).unwrap();
     let light = scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::new(0.0, 0.5, 0.0)).unwrap();
