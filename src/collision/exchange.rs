@@ -38,6 +38,7 @@ pub(super) type SolvedBody<'a> = (
     Option<&'a AngularVelocity>,
 );
 
+/// Bodies the contact systems see: not quarantined.
 pub(super) type Live = Without<Quarantined>;
 
 /// Where each solver body sits in the query's storage order, for one step.

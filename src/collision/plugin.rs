@@ -6,7 +6,7 @@ use parry3d::math::Pose;
 use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 
 use super::broad::{BroadPhase, Entry};
-use super::exchange::{SolvedBody, gather, scatter};
+use super::exchange::{Live, SolvedBody, gather, scatter};
 use super::narrow::{ContactImpulse, Contacts, FrictionImpulse, PairState, keep_points};
 use super::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody};
 use super::{
@@ -16,13 +16,10 @@ use super::{
 use crate::Plugin;
 use crate::integrator::ConstraintsActive;
 use crate::particles::{LinearVelocity, Mass, Position};
-use crate::quarantine::Quarantined;
 use crate::rigid::{AngularVelocity, CenterOfMass, Inertia, Rotation};
 use crate::schedule::{PhysicsSchedule, PrepareSystems, StepSystems, SubstepSchedule, add_systems};
 use crate::sleep::Sleeping;
 use crate::time::{PhysicsTime, SubstepTime};
-
-type Live = Without<Quarantined>;
 
 /// Colliders, contacts and the contact solver. Every system runs only while a collider
 /// exists; the solver only while some contact does.

@@ -28,7 +28,8 @@
 //! spin about the major axis creeps towards the minor axis. The default is therefore a
 //! free-rotation splitting ([`free_rotation_split`]): symplectic, |L| exact, energy error
 //! bounded. A body with three equal moments (a sphere, a cube) has constant ω = L/I, and the
-//! splitting takes the exact single turn exp(½ h ω) for it. RK4 integrates q as a 4-vector with the derivative ½ ω ⊗ q at each stage. The
+//! splitting takes the exact single turn exp(½ h ω) for it. RK4 integrates q as a 4-vector
+//! with the derivative ½ ω ⊗ q at each stage. The
 //! [`StepSystems::Renormalize`](crate::StepSystems::Renormalize) set renormalises q every
 //! substep unless [`Renormalization`] is off (to show its effect) or a body has
 //! [`SkipRenormalization`].
@@ -253,11 +254,11 @@ impl Inertia {
     #[must_use]
     #[inline]
     pub fn angular_velocity(&self, q: Quat, l: Vec3A) -> Vec3A {
-        // Rotating by a non-unit quaternion scales by |q|², and q is not unit between a
-        // first-order update and the renormalise set (or when that is off).
         if self.is_isotropic() {
             return self.inverse.x * l;
         }
+        // Rotating by a non-unit quaternion scales by |q|², and q is not unit between a
+        // first-order update and the renormalise set (or when that is off).
         let qf = unit(q) * self.frame;
         qf * (self.inverse * (qf.inverse() * l))
     }
