@@ -132,6 +132,7 @@ fn read(
     let b = &mut solver.bodies[i];
     let dr = Mat3A::from_quat(q.0 * b.q0.inverse());
     let w = match l {
+        Some(l) if b.dynamic && b.isotropic => b.inv_i.x_axis.x * l.0,
         Some(l) if b.dynamic => dr * (b.inv_i * (dr.transpose() * l.0)),
         _ => w.map_or(Vec3A::ZERO, |w| w.0),
     };
@@ -234,6 +235,7 @@ mod tests {
                 q0: Quat::IDENTITY,
                 w_in: Vec3A::ZERO,
                 dynamic: true,
+                isotropic: false,
             });
             solver.index.insert(e, i);
         }
@@ -320,6 +322,7 @@ mod tests {
             q0: Quat::IDENTITY,
             w_in: Vec3A::ZERO,
             dynamic: true,
+            isotropic: false,
         });
         solver.index.insert(e, 0);
         solver.states = vec![BodyState::REST; 2];

@@ -323,6 +323,7 @@ fn body_index(
         q0: q.0,
         w_in: w.map_or(Vec3A::ZERO, |w| w.0),
         dynamic,
+        isotropic: inertia.is_some_and(Inertia::is_isotropic),
     });
     solver.index.insert(e, i);
     i
@@ -366,11 +367,11 @@ fn prepare_contacts(
     bp: Res<BroadPhase>,
     settings: Res<ContactSettings>,
     bodies: Query<PreparedBody, (With<Collider>, Live)>,
-    mut world: Local<Vec<(Vec3A, f32, bool)>>,
+    mut local: Local<Vec<(Vec3A, f32, bool)>>,
 ) {
     let s = &mut *solver;
     s.clear();
-    let world = &mut *world;
+    let local = &mut *local;
     for &(ea, eb) in bp.pairs.iter().chain(&contacts.woken) {
         let Some(state) = contacts.pairs.get(&(ea, eb)) else {
             continue;
@@ -405,26 +406,29 @@ fn prepare_contacts(
                 continue;
             }
             let n = Vec3A::from(pose_a.rotation * m.local_n1);
-            world.clear();
-            world.extend(m.points.iter().map(|p| {
-                let pa = Vec3A::from(pose_a * p.local_p1);
-                let pb = Vec3A::from(pose_b * p.local_p2);
-                (0.5 * (pa + pb), p.dist, p.data != ContactImpulse::default())
+            // The choice only measures distances in the contact plane, so it is made in the
+            // first shape's frame, and only the kept points are carried to the world.
+            local.clear();
+            local.extend(m.points.iter().map(|p| {
+                let warm = p.data != ContactImpulse::default();
+                (Vec3A::from(p.local_p1), p.dist, warm)
             }));
             let first = s.inputs.len() as u32;
-            let (keep, count) = keep_points(world, n);
+            let (keep, count) = keep_points(local, Vec3A::from(m.local_n1));
             let kept = &keep[..count];
+            let mut mids = [Vec3A::ZERO; super::narrow::MAX_POINTS];
+            for (mid, &k) in mids.iter_mut().zip(kept) {
+                let p = &m.points[k];
+                *mid = 0.5 * (Vec3A::from(pose_a * p.local_p1) + Vec3A::from(pose_b * p.local_p2));
+            }
+            let mids = &mids[..count];
             // Friction acts at the kept points' centre; the twist's arm is their mean
             // distance from it.
-            let middle = kept.iter().map(|&k| world[k].0).sum::<Vec3A>() / count as f32;
+            let middle = mids.iter().sum::<Vec3A>() / count as f32;
             let t = tangent_basis(n, m, middle, (a.0.0, va, wa), (b.0.0, vb, wb));
-            let radius = kept
-                .iter()
-                .map(|&k| (world[k].0 - middle).length())
-                .sum::<f32>()
-                / count as f32;
-            for &k in kept {
-                let (p, mid) = (&m.points[k], world[k].0);
+            let radius = mids.iter().map(|&p| (p - middle).length()).sum::<f32>() / count as f32;
+            for (&k, &mid) in kept.iter().zip(mids) {
+                let p = &m.points[k];
                 let (r_a, r_b) = (mid - a.0.0, mid - b.0.0);
                 let rel = (vb + wb.cross(r_b)) - (va + wa.cross(r_a));
                 s.inputs.push(PointInput {

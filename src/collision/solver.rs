@@ -52,6 +52,8 @@ pub(crate) struct SolverBody {
     pub w_in: Vec3A,
     /// False for kinematic bodies and for bodies frozen out of the step.
     pub dynamic: bool,
+    /// Three equal principal moments: I⁻¹ is `inv_i`'s diagonal in every orientation.
+    pub isotropic: bool,
 }
 
 /// The velocity state of one body during a pass.

@@ -59,6 +59,7 @@ fn solver_with(bodies: usize, pairs: &[(u32, u32)]) -> ContactSolver {
             q0: Quat::IDENTITY,
             w_in: Vec3A::ZERO,
             dynamic: true,
+            isotropic: false,
         });
     }
     for (mi, &(a, b)) in pairs.iter().enumerate() {
