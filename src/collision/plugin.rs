@@ -8,7 +8,9 @@ use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 use super::broad::{BroadPhase, Entry};
 use super::exchange::{Live, SolvedBody, gather, scatter};
 use super::narrow::{ContactImpulse, Contacts, FrictionImpulse, PairState, keep_points};
-use super::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody};
+use super::solver::{
+    ContactSolver, EntitySlots, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody,
+};
 use super::{
     Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted,
     Friction, Restitution, Sensor,
@@ -189,6 +191,41 @@ type NarrowCollider<'a> = (
     Has<Sensor>,
 );
 
+/// What the narrow phase needs of one collider, fetched once per step however many pairs
+/// it is in.
+struct NarrowBody<'a> {
+    entity: Entity,
+    collider: &'a Collider,
+    pose: Pose,
+    /// Fastest speed of any point of the shape (m/s): |v| + |ω| r.
+    speed: f32,
+    sensor: bool,
+}
+
+/// Index of `e`'s [`NarrowBody`] in `bodies`, fetched on first use.
+fn narrow_body<'a>(
+    e: Entity,
+    slots: &mut EntitySlots,
+    bodies: &mut Vec<NarrowBody<'a>>,
+    colliders: &'a Query<NarrowCollider, Live>,
+) -> Option<usize> {
+    if let Some(i) = slots.find(e, |i| bodies.get(i).map(|b| b.entity)) {
+        return Some(i as usize);
+    }
+    let (collider, x, q, com, v, w, sensor) = colliders.get(e).ok()?;
+    let speed =
+        v.map_or(0.0, |v| v.0.length()) + w.map_or(0.0, |w| w.0.length() * radius(collider, com));
+    slots.insert(e, bodies.len() as u32);
+    bodies.push(NarrowBody {
+        entity: e,
+        collider,
+        pose: shape_pose(x.0, q.0, com),
+        speed,
+        sensor,
+    });
+    Some(bodies.len() - 1)
+}
+
 /// Persistent manifolds for every candidate pair; start/end messages.
 #[allow(clippy::too_many_arguments)] // two message writers and the queries of one pass
 fn update_contacts(
@@ -200,38 +237,37 @@ fn update_contacts(
     mut started: MessageWriter<ContactStarted>,
     mut ended: MessageWriter<ContactEnded>,
     sleeping: Query<(), With<Sleeping>>,
+    mut slots: Local<EntitySlots>,
 ) {
     let dt = time.dt();
     contacts.step += 1;
     contacts.woken.clear();
     let step = contacts.step;
     let touch = 0.25 * settings.margin;
+    let mut bodies = Vec::new();
     for &(a, b) in &bp.pairs {
-        let (Ok(ca), Ok(cb)) = (colliders.get(a), colliders.get(b)) else {
+        let (Some(ia), Some(ib)) = (
+            narrow_body(a, &mut slots, &mut bodies, &colliders),
+            narrow_body(b, &mut slots, &mut bodies, &colliders),
+        ) else {
             continue;
         };
-        let pose_a = shape_pose(ca.1.0, ca.2.0, ca.3);
-        let pose_b = shape_pose(cb.1.0, cb.2.0, cb.3);
-        let sensor = ca.6 || cb.6;
+        let (ca, cb) = (&bodies[ia], &bodies[ib]);
+        let (pose_a, pose_b) = (&ca.pose, &cb.pose);
+        let sensor = ca.sensor || cb.sensor;
         let state = contacts.pairs.entry((a, b)).or_insert_with(PairState::new);
         state.seen = step;
         state.sensor = sensor;
         let touching = if sensor {
-            parry3d::query::intersection_test(&pose_a, &**ca.0.shape(), &pose_b, &**cb.0.shape())
-                .is_ok_and(|i| i.intersecting)
+            let (sa, sb) = (&**ca.collider.shape(), &**cb.collider.shape());
+            parry3d::query::intersection_test(pose_a, sa, pose_b, sb).is_ok_and(|i| i.intersecting)
         } else {
-            let speed =
-                |v: Option<&LinearVelocity>, w: Option<&AngularVelocity>, c: &Collider, com| {
-                    v.map_or(0.0, |v| v.0.length())
-                        + w.map_or(0.0, |w| w.0.length() * radius(c, com))
-                };
-            let prediction = settings.margin
-                + (speed(ca.4, ca.5, ca.0, ca.3) + speed(cb.4, cb.5, cb.0, cb.3)) * dt;
-            let pos12 = pose_a.inverse() * pose_b;
+            let prediction = settings.margin + (ca.speed + cb.speed) * dt;
+            let pos12 = pose_a.inverse() * *pose_b;
             let result = DefaultQueryDispatcher.contact_manifolds(
                 &pos12,
-                &**ca.0.shape(),
-                &**cb.0.shape(),
+                &**ca.collider.shape(),
+                &**cb.collider.shape(),
                 prediction,
                 &mut state.manifolds,
                 &mut state.workspace,
@@ -254,6 +290,7 @@ fn update_contacts(
             }
         }
     }
+    slots.clear(bodies.iter().map(|b| b.entity));
     let mut gone: Vec<_> = contacts
         .pairs
         .iter()
@@ -360,6 +397,57 @@ fn tangent_basis(
 }
 
 /// Turns this step's manifolds into contact constraints.
+/// One side of the step's contacts as constraint building needs it, fetched once per step
+/// however many pairs its body is in.
+struct Side {
+    entity: Entity,
+    /// Solver index, or [`FIXED`].
+    index: u32,
+    x: Vec3A,
+    pose: Pose,
+    /// Velocity and angular velocity (zero for a [`FIXED`] side).
+    v: Vec3A,
+    w: Vec3A,
+    friction: f32,
+    restitution: f32,
+}
+
+/// Index of `e`'s [`Side`] in `sides`, fetched on first use.
+fn side(
+    e: Entity,
+    solver: &mut ContactSolver,
+    slots: &mut EntitySlots,
+    sides: &mut Vec<Side>,
+    bodies: &Query<PreparedBody, (With<Collider>, Live)>,
+) -> Option<usize> {
+    if let Some(i) = slots.find(e, |i| sides.get(i).map(|s| s.entity)) {
+        return Some(i as usize);
+    }
+    let b = bodies.get(e).ok()?;
+    let index = body_index(solver, e, &b);
+    let (v, w) = if index == FIXED {
+        (Vec3A::ZERO, Vec3A::ZERO)
+    } else {
+        (
+            b.4.map_or(Vec3A::ZERO, |v| v.0),
+            b.6.map_or(Vec3A::ZERO, |w| w.0),
+        )
+    };
+    slots.insert(e, sides.len() as u32);
+    sides.push(Side {
+        entity: e,
+        index,
+        x: b.0.0,
+        pose: shape_pose(b.0.0, b.1.0, b.2),
+        v,
+        w,
+        friction: b.7.0,
+        restitution: b.8.0,
+    });
+    Some(sides.len() - 1)
+}
+
+#[allow(clippy::too_many_arguments)] // the step's inputs and three reused buffers
 fn prepare_contacts(
     mut solver: ResMut<ContactSolver>,
     mut active: ResMut<ConstraintsActive>,
@@ -368,10 +456,13 @@ fn prepare_contacts(
     settings: Res<ContactSettings>,
     bodies: Query<PreparedBody, (With<Collider>, Live)>,
     mut local: Local<Vec<(Vec3A, f32, bool)>>,
+    mut buffers: Local<(EntitySlots, Vec<Side>)>,
 ) {
     let s = &mut *solver;
     s.clear();
     let local = &mut *local;
+    let (slots, sides) = &mut *buffers;
+    sides.clear();
     for &(ea, eb) in bp.pairs.iter().chain(&contacts.woken) {
         let Some(state) = contacts.pairs.get(&(ea, eb)) else {
             continue;
@@ -379,28 +470,23 @@ fn prepare_contacts(
         if state.sensor || state.manifolds.iter().all(|m| m.points.is_empty()) {
             continue;
         }
-        let (Ok(a), Ok(b)) = (bodies.get(ea), bodies.get(eb)) else {
+        let (Some(a), Some(b)) = (
+            side(ea, s, slots, sides, &bodies),
+            side(eb, s, slots, sides, &bodies),
+        ) else {
             continue;
         };
-        let (ia, ib) = (body_index(s, ea, &a), body_index(s, eb, &b));
+        let (a, b) = (&sides[a], &sides[b]);
+        let (ia, ib) = (a.index, b.index);
         if ia == FIXED && ib == FIXED {
             continue;
         }
-        let velocity = |b: &bevy_ecs::query::QueryItem<'_, '_, PreparedBody<'_>>, i: u32| {
-            if i == FIXED {
-                (Vec3A::ZERO, Vec3A::ZERO)
-            } else {
-                (
-                    b.4.map_or(Vec3A::ZERO, |v| v.0),
-                    b.6.map_or(Vec3A::ZERO, |w| w.0),
-                )
-            }
-        };
-        let ((va, wa), (vb, wb)) = (velocity(&a, ia), velocity(&b, ib));
-        let pose_a = shape_pose(a.0.0, a.1.0, a.2);
-        let pose_b = shape_pose(b.0.0, b.1.0, b.2);
-        let friction = settings.friction_rule.combine(a.7.0, b.7.0);
-        let restitution = settings.restitution_rule.combine(a.8.0, b.8.0);
+        let ((va, wa), (vb, wb)) = ((a.v, a.w), (b.v, b.w));
+        let (pose_a, pose_b) = (&a.pose, &b.pose);
+        let friction = settings.friction_rule.combine(a.friction, b.friction);
+        let restitution = settings
+            .restitution_rule
+            .combine(a.restitution, b.restitution);
         for (mi, m) in state.manifolds.iter().enumerate() {
             if m.points.is_empty() {
                 continue;
@@ -425,11 +511,11 @@ fn prepare_contacts(
             // Friction acts at the kept points' centre; the twist's arm is their mean
             // distance from it.
             let middle = mids.iter().sum::<Vec3A>() / count as f32;
-            let t = tangent_basis(n, m, middle, (a.0.0, va, wa), (b.0.0, vb, wb));
+            let t = tangent_basis(n, m, middle, (a.x, va, wa), (b.x, vb, wb));
             let radius = mids.iter().map(|&p| (p - middle).length()).sum::<f32>() / count as f32;
             for (&k, &mid) in kept.iter().zip(mids) {
                 let p = &m.points[k];
-                let (r_a, r_b) = (mid - a.0.0, mid - b.0.0);
+                let (r_a, r_b) = (mid - a.x, mid - b.x);
                 let rel = (vb + wb.cross(r_b)) - (va + wa.cross(r_a));
                 s.inputs.push(PointInput {
                     r_a,
@@ -452,14 +538,15 @@ fn prepare_contacts(
                 count: s.inputs.len() as u32 - first,
                 pair: (ea, eb),
                 manifold: mi as u32,
-                centre_a: middle - a.0.0,
-                centre_b: middle - b.0.0,
+                centre_a: middle - a.x,
+                centre_b: middle - b.x,
                 radius,
                 t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
                 twist: m.data.twist,
             });
         }
     }
+    slots.clear(sides.iter().map(|s| s.entity));
     s.build();
     active.0 = !s.manifolds.is_empty();
 }

@@ -202,39 +202,57 @@ pub(crate) struct ContactSolver {
     used: Vec<u64>,
 }
 
-/// Solver index per entity, kept in an array by the entity's index (a lookup is a load and
-/// a generation check, not a hash).
+/// A per-step index of items by entity, kept in an array by the entity's index: a lookup is
+/// a load and a check against the entity the item holds, not a hash.
 #[derive(Debug, Default)]
-pub(crate) struct BodyMap {
+pub(crate) struct EntitySlots {
     slots: Vec<u32>,
 }
 
-impl BodyMap {
-    /// The solver index of `e`, if it has one this step.
+impl EntitySlots {
+    /// The index of `e`'s item, if it has one; `entity_of(i)` is the entity item i holds.
     #[inline]
-    pub fn get(&self, e: Entity, bodies: &[SolverBody]) -> Option<u32> {
+    pub fn find(&self, e: Entity, entity_of: impl Fn(usize) -> Option<Entity>) -> Option<u32> {
         let i = *self.slots.get(e.index_u32() as usize)?;
-        bodies
-            .get(i as usize)
-            .is_some_and(|b| b.entity == e)
-            .then_some(i)
+        (entity_of(i as usize) == Some(e)).then_some(i)
     }
 
     pub fn insert(&mut self, e: Entity, i: u32) {
         let k = e.index_u32() as usize;
         if k >= self.slots.len() {
-            self.slots.resize(k + 1, FIXED);
+            self.slots.resize(k + 1, u32::MAX);
         }
         self.slots[k] = i;
     }
 
-    /// Empties the map of the step's `bodies`.
-    fn clear(&mut self, bodies: &[SolverBody]) {
-        for b in bodies {
-            if let Some(slot) = self.slots.get_mut(b.entity.index_u32() as usize) {
-                *slot = FIXED;
+    /// Forgets the given entities' items.
+    pub fn clear(&mut self, entities: impl Iterator<Item = Entity>) {
+        for e in entities {
+            if let Some(slot) = self.slots.get_mut(e.index_u32() as usize) {
+                *slot = u32::MAX;
             }
         }
+    }
+}
+
+/// Solver index per entity.
+#[derive(Debug, Default)]
+pub(crate) struct BodyMap(EntitySlots);
+
+impl BodyMap {
+    /// The solver index of `e`, if it has one this step.
+    #[inline]
+    pub fn get(&self, e: Entity, bodies: &[SolverBody]) -> Option<u32> {
+        self.0.find(e, |i| bodies.get(i).map(|b| b.entity))
+    }
+
+    pub fn insert(&mut self, e: Entity, i: u32) {
+        self.0.insert(e, i);
+    }
+
+    /// Empties the map of the step's `bodies`.
+    fn clear(&mut self, bodies: &[SolverBody]) {
+        self.0.clear(bodies.iter().map(|b| b.entity));
     }
 }
 
