@@ -2,9 +2,12 @@
 //! hierarchy over fixed ones.
 //!
 //! - **Moving** colliders (anything with a velocity) keep their order from the last step;
-//!   each step their boxes are updated in place and re-sorted by insertion sort along the
-//!   sweep axis, which for coherent motion is close to O(n). The set is rebuilt (O(n log n))
-//!   only when colliders are added or removed.
+//!   each step their boxes are updated in place and re-sorted by insertion sort, which for
+//!   coherent motion is close to O(n). The set is rebuilt (O(n log n)) only when colliders
+//!   are added or removed. The sort key is (cell, min along the sweep axis): cells are
+//!   slabs across a second axis, twice as thick as the largest box is along it, so a box
+//!   can only overlap boxes of its own slab or the next. Sweeping slab by slab keeps a
+//!   regular grid of boxes (a 10×10×10 stack) from testing every box of a whole row.
 //! - **Fixed** colliders sit in parry's BVH, rebuilt only when one of them is added, moved,
 //!   reshaped or removed. Each awake moving box queries it: O(log n_fixed) per box. A fixed
 //!   collider costs nothing per step while nothing about it changes.
@@ -26,6 +29,8 @@ pub(crate) struct Entry {
     /// False for sleeping bodies: they pair with awake bodies only.
     pub awake: bool,
     pub layers: CollisionLayers,
+    /// Slab index across the cell axis, set by the sweep.
+    pub cell: i32,
 }
 
 /// The broad phase's working set and its output, kept from step to step.
@@ -41,6 +46,8 @@ pub(crate) struct BroadPhase {
     /// Set when moving colliders were added or removed: their list is rebuilt.
     pub moving_dirty: bool,
     pub axis: usize,
+    /// The axis across which the slabs are cut.
+    pub cell_axis: usize,
     /// Candidate pairs (lower entity first), sorted.
     pub pairs: Vec<(Entity, Entity)>,
     /// The moving boxes in sweep order as six coordinate arrays, padded with empty boxes to
@@ -99,6 +106,7 @@ impl Default for BroadPhase {
             fixed_dirty: true,
             moving_dirty: true,
             axis: 0,
+            cell_axis: 2,
             pairs: Vec::new(),
             sweep: Sweep::default(),
         }
@@ -119,8 +127,9 @@ pub(crate) fn mark_dirty(world: &mut bevy_ecs::world::DeferredWorld, entity: Ent
     }
 }
 
-/// The axis along which box centres spread most: sweeping it leaves the fewest overlaps.
-pub(crate) fn sweep_axis(entries: &[Entry]) -> usize {
+/// The axes along which box centres spread most and next most: sweeping the first and
+/// cutting slabs across the second leave the fewest overlaps to test.
+pub(crate) fn sweep_axes(entries: &[Entry]) -> [usize; 2] {
     let n = entries.len().max(1) as f32;
     let mean = entries.iter().map(|e| e.min + e.max).sum::<Vec3>() / (2.0 * n);
     let var = entries
@@ -130,13 +139,42 @@ pub(crate) fn sweep_axis(entries: &[Entry]) -> usize {
             d * d
         })
         .sum::<Vec3>();
-    if var.x >= var.y && var.x >= var.z {
-        0
-    } else if var.y >= var.z {
-        1
-    } else {
-        2
+    let mut axes = [0, 1, 2];
+    // A stable sort: ties keep x before y before z.
+    axes.sort_by(|&a, &b| var[b].total_cmp(&var[a]));
+    [axes[0], axes[1]]
+}
+
+/// Sets every entry's slab across `axis`: slabs twice as thick as the thickest box, so two
+/// overlapping boxes are at most one slab apart even after rounding. Returns the widest
+/// extent along `along` (the sweep axis). Far from the origin (more than a million slabs
+/// out) or with no extent, everything shares one slab.
+fn assign_cells(entries: &mut [Entry], axis: usize, along: usize) -> f32 {
+    let (mut thick, mut wide) = (0.0f32, 0.0f32);
+    for e in entries.iter() {
+        thick = thick.max(e.max[axis] - e.min[axis]);
+        wide = wide.max(e.max[along] - e.min[along]);
     }
+    let size = 2.0 * thick;
+    let far = entries
+        .iter()
+        .any(|e| !(e.min[axis] / size).is_finite() || (e.min[axis] / size).abs() > 1e6);
+    for e in entries.iter_mut() {
+        e.cell = if size > 0.0 && !far {
+            (e.min[axis] / size).floor() as i32
+        } else {
+            0
+        };
+    }
+    wide
+}
+
+/// The sweep order: slab, then the box's start along the sweep axis, then the entity.
+fn sweep_order(a: &Entry, b: &Entry, axis: usize) -> std::cmp::Ordering {
+    a.cell
+        .cmp(&b.cell)
+        .then(a.min[axis].total_cmp(&b.min[axis]))
+        .then(a.entity.cmp(&b.entity))
 }
 
 fn key(a: Entity, b: Entity) -> (Entity, Entity) {
@@ -144,6 +182,27 @@ fn key(a: Entity, b: Entity) -> (Entity, Entity) {
 }
 
 impl BroadPhase {
+    /// Pairs box `i` with the boxes `from..to` (sorted by start along the sweep axis) that
+    /// start no later than `end`, four at a time.
+    #[inline]
+    fn sweep_run(&mut self, i: usize, from: usize, to: usize, end: f32) {
+        let keys = &self.sweep.min[self.axis];
+        let a = &self.moving[i];
+        let mut j = from;
+        while j < to && keys[j] <= end {
+            let live = (1u32 << (to - j).min(4)) - 1;
+            let mut hits = self.sweep.overlaps(i, j) & live;
+            while hits != 0 {
+                let b = &self.moving[j + hits.trailing_zeros() as usize];
+                hits &= hits - 1;
+                if (a.awake || b.awake) && a.layers.interacts(b.layers) {
+                    self.pairs.push(key(a.entity, b.entity));
+                }
+            }
+            j += 4;
+        }
+    }
+
     /// Rebuilds the fixed tree from `self.fixed` if it is out of date.
     pub fn refresh_fixed(&mut self) {
         if self.fixed_dirty {
@@ -157,49 +216,58 @@ impl BroadPhase {
     /// collects every overlapping pair that may interact.
     pub fn find_pairs(&mut self) {
         if self.moving_dirty {
-            self.axis = sweep_axis(&self.moving);
-            let axis = self.axis;
-            self.moving.sort_unstable_by(|a, b| {
-                a.min[axis]
-                    .total_cmp(&b.min[axis])
-                    .then(a.entity.cmp(&b.entity))
-            });
+            [self.axis, self.cell_axis] = sweep_axes(&self.moving);
+        }
+        let axis = self.axis;
+        let wide = assign_cells(&mut self.moving, self.cell_axis, axis);
+        if self.moving_dirty {
+            self.moving.sort_unstable_by(|a, b| sweep_order(a, b, axis));
             self.moving_dirty = false;
         } else {
-            let axis = self.axis;
             for i in 1..self.moving.len() {
                 let mut j = i;
-                while j > 0 && {
-                    let (p, q) = (&self.moving[j - 1], &self.moving[j]);
-                    p.min[axis]
-                        .total_cmp(&q.min[axis])
-                        .then(p.entity.cmp(&q.entity))
-                        .is_gt()
-                } {
+                while j > 0 && sweep_order(&self.moving[j - 1], &self.moving[j], axis).is_gt() {
                     self.moving.swap(j - 1, j);
                     j -= 1;
                 }
             }
         }
         self.pairs.clear();
-        let axis = self.axis;
         self.sweep.fill(&self.moving);
-        let keys = &self.sweep.min[axis];
-        for (i, a) in self.moving.iter().enumerate() {
-            let end = a.max[axis];
-            let mut j = i + 1;
-            // The padding's infinite keys stop the loop within the arrays.
-            while keys[j] <= end {
-                let mut hits = self.sweep.overlaps(i, j);
-                while hits != 0 {
-                    let b = &self.moving[j + hits.trailing_zeros() as usize];
-                    hits &= hits - 1;
-                    if (a.awake || b.awake) && a.layers.interacts(b.layers) {
-                        self.pairs.push(key(a.entity, b.entity));
-                    }
-                }
-                j += 4;
+        let n = self.moving.len();
+        let slab_end = |moving: &[Entry], i: usize| {
+            let cell = moving[i].cell;
+            moving[i..]
+                .iter()
+                .position(|b| b.cell != cell)
+                .map_or(n, |k| i + k)
+        };
+        // The current slab ends at `next`; `after` ends the slab after it when that one is
+        // adjacent (else `after == next`).
+        let (mut next, mut after) = (0, 0);
+        // Where the scan of the next slab starts: the boxes of a slab come in increasing
+        // start along the axis, so this only moves forward.
+        let mut from = 0;
+        for i in 0..n {
+            let cell = self.moving[i].cell;
+            if i == next {
+                next = slab_end(&self.moving, i);
+                after = match self.moving.get(next) {
+                    Some(b) if b.cell == cell.wrapping_add(1) => slab_end(&self.moving, next),
+                    _ => next,
+                };
+                from = next;
             }
+            let (lo, hi) = (self.moving[i].min[axis], self.moving[i].max[axis]);
+            // Its own slab: the boxes after it that start before it ends.
+            self.sweep_run(i, i + 1, next, hi);
+            // The next slab: boxes that start at most `wide` before it starts (any box
+            // starting earlier also ends before it starts).
+            let keys = &self.sweep.min[axis];
+            while from < after && keys[from] < lo - wide {
+                from += 1;
+            }
+            self.sweep_run(i, from, after, hi);
         }
         self.refresh_fixed();
         for a in self.moving.iter().filter(|a| a.awake) {
@@ -228,6 +296,7 @@ mod tests {
             max,
             awake: true,
             layers: CollisionLayers::default(),
+            cell: 0,
         }
     }
 
@@ -267,17 +336,91 @@ mod tests {
             vec![(1, 2), (1, 5), (1, 6), (2, 5), (3, 5), (4, 5)]
         );
         // Move box 3 onto box 4 (incremental path): the pairs follow.
-        bp.moving[2].min = Vec3::new(0.6, 5.5, 0.6);
-        bp.moving[2].max = Vec3::new(1.6, 6.5, 1.6);
+        // The sweep reorders the list: find boxes by entity.
+        let at = |bp: &BroadPhase, i: u32| {
+            bp.moving
+                .iter()
+                .position(|e| e.entity.index_u32() == i)
+                .unwrap()
+        };
+        let three = at(&bp, 3);
+        bp.moving[three].min = Vec3::new(0.6, 5.5, 0.6);
+        bp.moving[three].max = Vec3::new(1.6, 6.5, 1.6);
         bp.find_pairs();
         assert_eq!(
             ids(&bp),
             vec![(1, 2), (1, 5), (1, 6), (2, 5), (3, 4), (3, 5), (4, 5)]
         );
         // Asleep with asleep: no pair; asleep with awake or fixed as before.
-        bp.moving[2].awake = false;
-        bp.moving[3].awake = false;
+        let (three, four) = (at(&bp, 3), at(&bp, 4));
+        bp.moving[three].awake = false;
+        bp.moving[four].awake = false;
         bp.find_pairs();
         assert!(!ids(&bp).contains(&(3, 4)) && !ids(&bp).contains(&(3, 5)));
+    }
+    /// A deterministic scatter of boxes of mixed sizes, some asleep.
+    fn scatter(n: u32, seed: u32, spread: f32) -> Vec<Entry> {
+        let mut state = seed;
+        let mut next = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1u32 << 24) as f32
+        };
+        (0..n)
+            .map(|i| {
+                let c = Vec3::new(next(), next(), next()) * spread;
+                let half = Vec3::new(next(), next(), next()) * 0.8 + Vec3::splat(0.05);
+                let mut e = entry(i + 1, c - half, c + half);
+                e.awake = i % 7 != 0;
+                e
+            })
+            .collect()
+    }
+
+    fn brute_force(entries: &[Entry]) -> Vec<(Entity, Entity)> {
+        let mut out = Vec::new();
+        for (i, a) in entries.iter().enumerate() {
+            for b in &entries[i + 1..] {
+                let overlap = a.min.cmple(b.max).all() && b.min.cmple(a.max).all();
+                if overlap && (a.awake || b.awake) {
+                    out.push(key(a.entity, b.entity));
+                }
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+
+    #[test]
+    fn slab_sweep_finds_exactly_the_brute_force_pairs_as_boxes_move() {
+        for (seed, spread) in [(1, 12.0), (2, 30.0), (3, 4.0)] {
+            let mut moving = scatter(400, seed, spread);
+            // One long box across everything: thick slabs, every pair still found.
+            if seed == 2 {
+                moving[5].max.z += 20.0;
+            }
+            let mut bp = BroadPhase {
+                moving: moving.clone(),
+                ..Default::default()
+            };
+            bp.refresh_fixed();
+            bp.find_pairs();
+            assert_eq!(bp.pairs, brute_force(&moving), "seed {seed}");
+            // Move every box a little (incremental re-sort) and a few a lot.
+            for step in 0..3u32 {
+                for (k, e) in bp.moving.iter_mut().enumerate() {
+                    let d = if k % 50 == 0 { 3.0 } else { 0.2 };
+                    let shift = Vec3::new(
+                        ((k as u32 * 7 + step) % 5) as f32 - 2.0,
+                        ((k as u32 * 3 + step) % 3) as f32 - 1.0,
+                        ((k as u32 + step * 5) % 7) as f32 - 3.0,
+                    ) * (d / 3.0);
+                    e.min += shift;
+                    e.max += shift;
+                }
+                let now = bp.moving.clone();
+                bp.find_pairs();
+                assert_eq!(bp.pairs, brute_force(&now), "seed {seed}, step {step}");
+            }
+        }
     }
 }

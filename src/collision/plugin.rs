@@ -148,6 +148,7 @@ fn entry(
         max: aabb.max,
         awake: !sleeping,
         layers: *layers,
+        cell: 0,
     }
 }
 
