@@ -156,15 +156,15 @@ fn assign_cells(entries: &mut [Entry], axis: usize, along: usize) -> f32 {
         wide = wide.max(e.max[along] - e.min[along]);
     }
     let size = 2.0 * thick;
-    let far = entries
-        .iter()
-        .any(|e| !(e.min[axis] / size).is_finite() || (e.min[axis] / size).abs() > 1e6);
+    // With no extent every slab index is infinite or NaN: one slab.
+    let mut far = false;
     for e in entries.iter_mut() {
-        e.cell = if size > 0.0 && !far {
-            (e.min[axis] / size).floor() as i32
-        } else {
-            0
-        };
+        let slab = e.min[axis] / size;
+        far |= !slab.is_finite() || slab.abs() > 1e6;
+        e.cell = slab.floor() as i32;
+    }
+    if far {
+        entries.iter_mut().for_each(|e| e.cell = 0);
     }
     wide
 }

@@ -89,6 +89,31 @@ fn record(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
     }
 }
 
+/// Visits each solver body found at its recorded position of the storage-order walk
+/// `items` and marks it reached in `pass`; bodies not found are left for lookups.
+fn walk<Q>(
+    solver: &mut ContactSolver,
+    items: impl Iterator<Item = Q>,
+    entity: impl Fn(&Q) -> Entity,
+    pass: u32,
+    mut visit: impl FnMut(&mut ContactSolver, usize, Q),
+) {
+    let slots = std::mem::take(&mut solver.order.slots);
+    // `for_each` takes the query's table-at-a-time fold; a `zip` would not.
+    items.enumerate().for_each(|(k, item)| {
+        let slot = slots.get(k).copied().unwrap_or(NONE) as usize;
+        if solver
+            .bodies
+            .get(slot)
+            .is_some_and(|b| b.entity == entity(&item))
+        {
+            visit(solver, slot, item);
+            solver.order.reached[slot] = pass;
+        }
+    });
+    solver.order.slots = slots;
+}
+
 /// Reads the current state of every body in contact into the solver.
 pub(super) fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
     if !solver.order.ready {
@@ -97,16 +122,15 @@ pub(super) fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live
     let pass = solver.order.begin(solver.bodies.len());
     let mut frozen = Vec::new();
     if solver.order.walk {
-        let slots = std::mem::take(&mut solver.order.slots);
-        // `for_each` takes the query's table-at-a-time fold; a `zip` would not.
-        bodies.iter().enumerate().for_each(|(k, item)| {
-            let slot = slots.get(k).copied().unwrap_or(NONE);
-            if slot != NONE && solver.bodies[slot as usize].entity == item.0 {
-                read(solver, slot as usize, item, &mut frozen);
-                solver.order.reached[slot as usize] = pass;
-            }
-        });
-        solver.order.slots = slots;
+        walk(
+            solver,
+            bodies.iter(),
+            |item| item.0,
+            pass,
+            |solver, i, item| {
+                read(solver, i, item, &mut frozen);
+            },
+        );
     }
     for i in 0..solver.bodies.len() {
         if solver.order.reached[i] != pass
@@ -159,15 +183,15 @@ fn read(
 pub(super) fn scatter(solver: &mut ContactSolver, bodies: &mut Query<SolvedBody, Live>) {
     let pass = solver.order.begin(solver.bodies.len());
     if solver.order.walk && solver.order.ready {
-        let slots = std::mem::take(&mut solver.order.slots);
-        bodies.iter_mut().enumerate().for_each(|(k, item)| {
-            let slot = slots.get(k).copied().unwrap_or(NONE);
-            if slot != NONE && solver.bodies[slot as usize].entity == item.0 {
-                write(solver, slot as usize, item);
-                solver.order.reached[slot as usize] = pass;
-            }
-        });
-        solver.order.slots = slots;
+        walk(
+            solver,
+            bodies.iter_mut(),
+            |item| item.0,
+            pass,
+            |solver, i, item| {
+                write(solver, i, item);
+            },
+        );
     }
     for i in 0..solver.bodies.len() {
         if solver.order.reached[i] != pass
