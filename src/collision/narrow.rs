@@ -189,11 +189,13 @@ impl Contacts {
             sensor: s.sensor,
         };
         for m in &s.manifolds {
+            // A compound's manifold is in its part's frame.
+            let part = m.subshape_pos1().copied().unwrap_or_default();
             for p in &m.points {
-                out.points.push(p.local_p1);
+                out.points.push(part * p.local_p1);
                 if -p.dist > out.depth || out.normal == Vec3::ZERO {
                     out.depth = out.depth.max(-p.dist);
-                    out.normal = m.local_n1;
+                    out.normal = part.rotation * m.local_n1;
                 }
                 out.normal_impulse += p.data.normal;
             }

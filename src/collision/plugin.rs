@@ -71,6 +71,12 @@ fn contacts_active(solver: Res<ContactSolver>) -> bool {
 }
 
 /// The pose of a collider's shape frame: origin x − R c.
+/// The world pose of a manifold's part: the shape's pose, then the part's pose in it.
+#[inline]
+fn part_pose(shape: &Pose, part: Option<&Pose>) -> Pose {
+    part.map_or(*shape, |p| *shape * *p)
+}
+
 fn shape_pose(x: Vec3A, q: Quat, com: Option<&CenterOfMass>) -> Pose {
     let c = com.map_or(Vec3::ZERO, |c| c.0);
     Pose::from_parts(Vec3::from(x) - q * c, q)
@@ -492,6 +498,12 @@ fn prepare_contacts(
             if m.points.is_empty() {
                 continue;
             }
+            // A compound's manifold is in its part's frame; the part's pose in the compound
+            // comes with the manifold.
+            let (pose_a, pose_b) = (
+                part_pose(pose_a, m.subshape_pos1()),
+                part_pose(pose_b, m.subshape_pos2()),
+            );
             let n = Vec3A::from(pose_a.rotation * m.local_n1);
             // The choice only measures distances in the contact plane, so it is made in the
             // first shape's frame, and only the kept points are carried to the world.
