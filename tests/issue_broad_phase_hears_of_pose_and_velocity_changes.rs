@@ -8,16 +8,10 @@ use glam::{Quat, Vec3};
 use hooke::prelude::*;
 use hooke::scenes;
 
+mod common;
+
 fn world() -> World {
-    let mut w = scenes::world_with(
-        1.0 / 60.0,
-        4,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -9.81, 0.0),
-    )
-    .unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
-    w
+    common::contact_world(4)
 }
 
 fn y(w: &World, e: Entity) -> f32 {
