@@ -9,7 +9,9 @@
 //!    put, and the broad phase hears of a change through component hooks, so move a static
 //!    collider by inserting a new `Position` or `Rotation` (or make it kinematic);
 //! 3. narrow phase: parry's persistent contact manifolds per pair, which carry each contact's
-//!    impulses from step to step by feature id (warm starting); contact start/end messages;
+//!    impulses from step to step by feature id (warm starting); contact start/end messages.
+//!    A pair that moved less than [`ContactSettings::recycle_distance`] relative to itself
+//!    since its manifolds were found keeps them and only updates their separations;
 //! 4. contact constraints with anchors, effective masses and the approach speed.
 //!
 //! **Solver, every substep** (Box2D v3's soft step): after the velocities are integrated,
@@ -379,6 +381,12 @@ pub struct ContactSettings {
     pub restitution_threshold: f32,
     /// Extra margin around bounding boxes and in contact prediction (m).
     pub margin: f32,
+    /// How far a pair may move relative to itself before its contact manifolds are found
+    /// again (m; at most [`ContactSettings::margin`], 0 finds them every step). Until then the
+    /// points ride with the shapes and only their separations are updated, which is exact in
+    /// depth and stale in position by at most this distance. rapier does the same with a
+    /// default of 0.05 m.
+    pub recycle_distance: f32,
     /// How frictions combine.
     pub friction_rule: CombineRule,
     /// How restitutions combine.
@@ -393,6 +401,7 @@ impl Default for ContactSettings {
             max_push_velocity: 3.0,
             restitution_threshold: 1.0,
             margin: 0.02,
+            recycle_distance: 0.005,
             friction_rule: CombineRule::GeometricMean,
             restitution_rule: CombineRule::Max,
         }

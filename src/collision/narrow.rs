@@ -4,6 +4,7 @@ use bevy_platform::collections::HashMap;
 
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
+use parry3d::math::Pose;
 use parry3d::query::{ContactManifold, ContactManifoldsWorkspace};
 
 /// What each contact point carries from step to step: its accumulated normal impulse, for
@@ -14,16 +15,29 @@ pub(crate) struct ContactImpulse {
     pub normal: f32,
 }
 
-/// What a manifold carries from step to step: its friction impulses, for warm starting.
+/// What a manifold carries from step to step: its friction impulses, for warm starting, and
+/// which of its points the solver takes (chosen when its points are found, see
+/// [`choose_points`]).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct FrictionImpulse {
+pub(crate) struct ManifoldData {
     /// Friction impulse at the manifold's centre (N·s, world frame).
     pub tangent: Vec3,
     /// Twist impulse about the normal (N·m·s).
     pub twist: f32,
+    /// Indices of the points solved, the first `kept_len`.
+    pub kept: [u8; MAX_POINTS],
+    pub kept_len: u8,
 }
 
-pub(crate) type Manifold = ContactManifold<FrictionImpulse, ContactImpulse>;
+impl ManifoldData {
+    /// The indices of the points the solver takes.
+    #[must_use]
+    pub fn kept(&self) -> &[u8] {
+        &self.kept[..usize::from(self.kept_len)]
+    }
+}
+
+pub(crate) type Manifold = ContactManifold<ManifoldData, ContactImpulse>;
 
 /// One pair's state.
 pub(crate) struct PairState {
@@ -32,6 +46,36 @@ pub(crate) struct PairState {
     pub touching: bool,
     pub sensor: bool,
     pub seen: u64,
+    /// Where the last full update ran, while its manifolds may be reused.
+    pub recycle: Option<Recycle>,
+}
+
+/// The relative pose and reach of a pair's last full manifold update.
+///
+/// Reusing a manifold is exact in what it covers as long as the pair moved little since:
+/// the update looked `prediction + window` deep, a feature it did not report was at least
+/// that far away, and it is still farther than the current prediction if the drift plus any
+/// growth of the prediction stays within `window`. The drift bounds how far any point of
+/// the second shape moved in the first shape's frame: |Δt| + 2 |sin(Δθ/2)| r for a shape
+/// within r of its origin.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Recycle {
+    /// The second shape's pose in the first's frame.
+    pub pos12: Pose,
+    /// The prediction distance asked of parry, window included (m).
+    pub reach: f32,
+}
+
+impl Recycle {
+    /// True when manifolds found at `self` still hold at `pos12` for a prediction of
+    /// `prediction`, the second shape lying within `extent` of its origin.
+    #[must_use]
+    pub fn holds(&self, pos12: &Pose, extent: f32, prediction: f32) -> bool {
+        let turn = self.pos12.rotation.inverse() * pos12.rotation;
+        let drift = (pos12.translation - self.pos12.translation).length()
+            + 2.0 * turn.xyz().length() * extent;
+        drift + prediction <= self.reach
+    }
 }
 
 impl PairState {
@@ -42,6 +86,7 @@ impl PairState {
             touching: false,
             sensor: false,
             seen: 0,
+            recycle: None,
         }
     }
 }
@@ -50,6 +95,24 @@ impl PairState {
 /// parry's face–face clipping can give eight (a box resting squarely on another), which
 /// doubles the work for no better support.
 pub(crate) const MAX_POINTS: usize = 4;
+
+/// Chooses the points of `m` the solver takes (see [`keep_points`]) and records them in its
+/// data. Called when its points are found: a reused manifold keeps the choice.
+pub(crate) fn choose_points(m: &mut Manifold, scratch: &mut Vec<(Vec3A, f32, bool)>) {
+    scratch.clear();
+    scratch.extend(m.points.iter().map(|p| {
+        let warm = p.data != ContactImpulse::default();
+        (Vec3A::from(p.local_p1), p.dist, warm)
+    }));
+    // The choice only measures distances in the contact plane, so it is made in the first
+    // shape's (or part's) frame.
+    let (keep, count) = keep_points(scratch, Vec3A::from(m.local_n1));
+    for (k, &i) in m.data.kept.iter_mut().zip(&keep[..count]) {
+        // parry's manifolds hold far fewer than 256 points.
+        *k = i as u8;
+    }
+    m.data.kept_len = count as u8;
+}
 
 /// Which of a manifold's points to solve when it has more than [`MAX_POINTS`]: the deepest,
 /// the one farthest from it, the one making the largest triangle with those two, and the one
@@ -294,5 +357,41 @@ mod tests {
         let mut unique = kept.to_vec();
         unique.dedup();
         assert_eq!(unique.len(), count);
+    }
+
+    #[test]
+    fn the_drift_bound_covers_every_point_of_the_moved_shape_and_no_more() {
+        let half = Vec3::new(0.5, 0.3, 0.2);
+        let extent = half.length();
+        let then = Pose::from_parts(Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY);
+        let now = Pose::from_parts(
+            Vec3::new(0.001, 1.0, -0.002),
+            glam::Quat::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.004),
+        );
+        // The farthest any corner of the box moved, measured.
+        let mut moved = 0.0f32;
+        for i in 0..8 {
+            let c = half
+                * Vec3::new(
+                    if i & 1 == 0 { -1.0 } else { 1.0 },
+                    if i & 2 == 0 { -1.0 } else { 1.0 },
+                    if i & 4 == 0 { -1.0 } else { 1.0 },
+                );
+            moved = moved.max((now * c - then * c).length());
+        }
+        let bound = (now.translation - then.translation).length() + 2.0 * (0.002f32).sin() * extent;
+        assert!(
+            moved <= bound + 1e-6 && bound < 1.2 * moved,
+            "{moved} vs {bound}"
+        );
+        let prediction = 0.02;
+        let reach = |slack: f32| Recycle {
+            pos12: then,
+            reach: prediction + bound + slack,
+        };
+        assert!(reach(1e-5).holds(&now, extent, prediction));
+        assert!(!reach(-1e-5).holds(&now, extent, prediction));
+        // A faster pair asks for a deeper prediction, which the old search may not cover.
+        assert!(!reach(1e-5).holds(&now, extent, prediction + 2e-5));
     }
 }

@@ -7,7 +7,7 @@ use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 
 use super::broad::{BroadPhase, Entry};
 use super::exchange::{Live, SolvedBody, gather, scatter};
-use super::narrow::{ContactImpulse, Contacts, FrictionImpulse, PairState, keep_points};
+use super::narrow::{ContactImpulse, Contacts, PairState, Recycle, choose_points};
 use super::solver::{
     ContactSolver, EntitySlots, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody,
 };
@@ -70,13 +70,27 @@ fn contacts_active(solver: Res<ContactSolver>) -> bool {
     !solver.manifolds.is_empty()
 }
 
-/// The pose of a collider's shape frame: origin x − R c.
+/// The second part's pose in the first part's frame, from the second shape's pose in the
+/// first's.
+#[inline]
+fn part_pose12(m: &super::narrow::Manifold, pos12: &Pose) -> Pose {
+    match (m.subshape_pos1(), m.subshape_pos2()) {
+        (None, None) => *pos12,
+        (p1, p2) => {
+            let p1 = p1.copied().unwrap_or_default();
+            let p2 = p2.copied().unwrap_or_default();
+            p1.inverse() * *pos12 * p2
+        }
+    }
+}
+
 /// The world pose of a manifold's part: the shape's pose, then the part's pose in it.
 #[inline]
 fn part_pose(shape: &Pose, part: Option<&Pose>) -> Pose {
     part.map_or(*shape, |p| *shape * *p)
 }
 
+/// The pose of a collider's shape frame: origin x − R c.
 fn shape_pose(x: Vec3A, q: Quat, com: Option<&CenterOfMass>) -> Pose {
     let c = com.map_or(Vec3::ZERO, |c| c.0);
     Pose::from_parts(Vec3::from(x) - q * c, q)
@@ -189,7 +203,7 @@ fn run_broad_phase(
 }
 
 type NarrowCollider<'a> = (
-    &'a Collider,
+    Ref<'a, Collider>,
     &'a Position,
     &'a Rotation,
     Option<&'a CenterOfMass>,
@@ -206,6 +220,10 @@ struct NarrowBody<'a> {
     pose: Pose,
     /// Fastest speed of any point of the shape (m/s): |v| + |ω| r.
     speed: f32,
+    /// Farthest any point of the shape is from the shape's origin (m).
+    extent: f32,
+    /// The collider was replaced or changed since the last step.
+    changed: bool,
     sensor: bool,
 }
 
@@ -220,6 +238,9 @@ fn narrow_body<'a>(
         return Some(i as usize);
     }
     let (collider, x, q, com, v, w, sensor) = colliders.get(e).ok()?;
+    let changed = collider.is_changed();
+    let collider = collider.into_inner();
+    let [lo, hi] = collider.local_bounds();
     let speed =
         v.map_or(0.0, |v| v.0.length()) + w.map_or(0.0, |w| w.0.length() * radius(collider, com));
     slots.insert(e, bodies.len() as u32);
@@ -228,10 +249,15 @@ fn narrow_body<'a>(
         collider,
         pose: shape_pose(x.0, q.0, com),
         speed,
+        extent: lo.abs().max(hi.abs()).length(),
+        changed,
         sensor,
     });
     Some(bodies.len() - 1)
 }
+
+/// The narrow phase's reused buffers: body slots, and the point list of the point choice.
+type NarrowBuffers = (EntitySlots, Vec<(Vec3A, f32, bool)>);
 
 /// Persistent manifolds for every candidate pair; start/end messages.
 #[allow(clippy::too_many_arguments)] // two message writers and the queries of one pass
@@ -244,18 +270,24 @@ fn update_contacts(
     mut started: MessageWriter<ContactStarted>,
     mut ended: MessageWriter<ContactEnded>,
     sleeping: Query<(), With<Sleeping>>,
-    mut slots: Local<EntitySlots>,
+    mut buffers: Local<NarrowBuffers>,
 ) {
+    let (slots, scratch) = &mut *buffers;
     let dt = time.dt();
     contacts.step += 1;
     contacts.woken.clear();
     let step = contacts.step;
     let touch = 0.25 * settings.margin;
+    let window = match settings.recycle_distance {
+        r if r > 0.0 => r.min(settings.margin),
+        // Zero, negative or not a number: no reuse.
+        _ => 0.0,
+    };
     let mut bodies = Vec::new();
     for &(a, b) in &bp.pairs {
         let (Some(ia), Some(ib)) = (
-            narrow_body(a, &mut slots, &mut bodies, &colliders),
-            narrow_body(b, &mut slots, &mut bodies, &colliders),
+            narrow_body(a, slots, &mut bodies, &colliders),
+            narrow_body(b, slots, &mut bodies, &colliders),
         ) else {
             continue;
         };
@@ -271,16 +303,38 @@ fn update_contacts(
         } else {
             let prediction = settings.margin + (ca.speed + cb.speed) * dt;
             let pos12 = pose_a.inverse() * *pose_b;
-            let result = DefaultQueryDispatcher.contact_manifolds(
-                &pos12,
-                &**ca.collider.shape(),
-                &**cb.collider.shape(),
-                prediction,
-                &mut state.manifolds,
-                &mut state.workspace,
-            );
-            if result.is_err() {
-                state.manifolds.clear();
+            let changed = ca.changed || cb.changed;
+            match state.recycle {
+                Some(r) if !changed && r.holds(&pos12, cb.extent, prediction) => {
+                    for m in &mut state.manifolds {
+                        m.update_separations(&part_pose12(m, &pos12));
+                    }
+                }
+                _ => {
+                    if changed {
+                        // parry reuses points itself while a pose holds still, and cannot tell
+                        // that a shape changed: start from nothing.
+                        state.manifolds.clear();
+                        state.workspace = None;
+                    }
+                    let reach = prediction + window;
+                    let result = DefaultQueryDispatcher.contact_manifolds(
+                        &pos12,
+                        &**ca.collider.shape(),
+                        &**cb.collider.shape(),
+                        reach,
+                        &mut state.manifolds,
+                        &mut state.workspace,
+                    );
+                    if result.is_err() {
+                        state.manifolds.clear();
+                    }
+                    state.recycle =
+                        (window > 0.0 && result.is_ok()).then_some(Recycle { pos12, reach });
+                    for m in &mut state.manifolds {
+                        choose_points(m, scratch);
+                    }
+                }
             }
             state
                 .manifolds
@@ -454,7 +508,7 @@ fn side(
     Some(sides.len() - 1)
 }
 
-#[allow(clippy::too_many_arguments)] // the step's inputs and three reused buffers
+#[allow(clippy::too_many_arguments)] // the step's inputs and its reused buffers
 fn prepare_contacts(
     mut solver: ResMut<ContactSolver>,
     mut active: ResMut<ConstraintsActive>,
@@ -462,12 +516,10 @@ fn prepare_contacts(
     bp: Res<BroadPhase>,
     settings: Res<ContactSettings>,
     bodies: Query<PreparedBody, (With<Collider>, Live)>,
-    mut local: Local<Vec<(Vec3A, f32, bool)>>,
     mut buffers: Local<(EntitySlots, Vec<Side>)>,
 ) {
     let s = &mut *solver;
     s.clear();
-    let local = &mut *local;
     let (slots, sides) = &mut *buffers;
     sides.clear();
     for &(ea, eb) in bp.pairs.iter().chain(&contacts.woken) {
@@ -505,19 +557,12 @@ fn prepare_contacts(
                 part_pose(pose_b, m.subshape_pos2()),
             );
             let n = Vec3A::from(pose_a.rotation * m.local_n1);
-            // The choice only measures distances in the contact plane, so it is made in the
-            // first shape's frame, and only the kept points are carried to the world.
-            local.clear();
-            local.extend(m.points.iter().map(|p| {
-                let warm = p.data != ContactImpulse::default();
-                (Vec3A::from(p.local_p1), p.dist, warm)
-            }));
             let first = s.inputs.len() as u32;
-            let (keep, count) = keep_points(local, Vec3A::from(m.local_n1));
-            let kept = &keep[..count];
+            let kept = m.data.kept();
+            let count = kept.len();
             let mut mids = [Vec3A::ZERO; super::narrow::MAX_POINTS];
             for (mid, &k) in mids.iter_mut().zip(kept) {
-                let p = &m.points[k];
+                let p = &m.points[usize::from(k)];
                 *mid = 0.5 * (Vec3A::from(pose_a * p.local_p1) + Vec3A::from(pose_b * p.local_p2));
             }
             let mids = &mids[..count];
@@ -527,7 +572,7 @@ fn prepare_contacts(
             let t = tangent_basis(n, m, middle, (a.x, va, wa), (b.x, vb, wb));
             let radius = mids.iter().map(|&p| (p - middle).length()).sum::<f32>() / count as f32;
             for (&k, &mid) in kept.iter().zip(mids) {
-                let p = &m.points[k];
+                let p = &m.points[usize::from(k)];
                 let (r_a, r_b) = (mid - a.x, mid - b.x);
                 let rel = (vb + wb.cross(r_b)) - (va + wa.cross(r_a));
                 s.inputs.push(PointInput {
@@ -536,7 +581,7 @@ fn prepare_contacts(
                     base: p.dist - n.dot(r_b - r_a),
                     n_imp: p.data.normal,
                     approach: n.dot(rel),
-                    source: k as u32,
+                    source: u32::from(k),
                 });
             }
             let tangent = Vec3A::from(m.data.tangent);
@@ -620,10 +665,8 @@ fn relax_contacts(
                     p.data = ContactImpulse { normal };
                 }
             }
-            tracked.data = FrictionImpulse {
-                tangent: solved.tangent.into(),
-                twist: solved.twist,
-            };
+            tracked.data.tangent = solved.tangent.into();
+            tracked.data.twist = solved.twist;
         }
     }
     scatter(&mut solver, &mut bodies);
