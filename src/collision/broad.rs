@@ -8,6 +8,8 @@
 //!   slabs across a second axis, twice as thick as the largest box is along it, so a box
 //!   can only overlap boxes of its own slab or the next. Sweeping slab by slab keeps a
 //!   regular grid of boxes (a 10×10×10 stack) from testing every box of a whole row.
+//!   The boxes are held grown a little (see the collision plugin's `run_broad_phase`), and
+//!   while none of them changed the last pairs still hold and the sweep does not run.
 //! - **Fixed** colliders sit in parry's BVH, rebuilt only when one of them is added, moved,
 //!   reshaped or removed. Each awake moving box queries it: O(log n_fixed) per box. A fixed
 //!   collider costs nothing per step while nothing about it changes.

@@ -174,18 +174,43 @@ fn entry(
 
 /// Keeps the broad phase's lists current: moving boxes in place, rebuilding a list only
 /// when colliders were added, removed or quarantined.
+///
+/// The broad phase holds each moving box grown by a tenth of the margin, and keeps it while
+/// the collider's box stays inside and no face is twice that far in: a resting body then changes nothing, and when no box
+/// changed the last step's pairs still hold and the sweep is skipped. The pairs are those of
+/// the grown boxes, a superset of the exact ones that the narrow phase sorts out.
 fn run_broad_phase(
     mut bp: ResMut<BroadPhase>,
+    settings: Res<ContactSettings>,
     moving: Query<BroadCollider, (With<Collider>, With<LinearVelocity>, Live)>,
     fixed: Query<BroadCollider, (With<Collider>, Without<LinearVelocity>, Live)>,
 ) {
     let bp = &mut *bp;
+    let fat = Vec3::splat(0.1 * settings.margin.max(0.0));
+    let grown = |mut e: Entry| {
+        (e.min, e.max) = (e.min - fat, e.max + fat);
+        e
+    };
+    let mut changed = bp.moving_dirty || bp.fixed_dirty;
     if !bp.moving_dirty {
         for e in &mut bp.moving {
             match moving.get(e.entity) {
-                Ok(c) => *e = entry(c),
+                Ok(c) => {
+                    let now = entry(c);
+                    // Inside, and not so far inside that the box was grown for a speed
+                    // the body no longer has.
+                    let (below, above) = (now.min - e.min, e.max - now.max);
+                    let fits = below.cmpge(Vec3::ZERO).all()
+                        && above.cmpge(Vec3::ZERO).all()
+                        && below.max(above).cmple(2.0 * fat).all();
+                    if !(fits && now.awake == e.awake && now.layers == e.layers) {
+                        *e = grown(now);
+                        changed = true;
+                    }
+                }
                 Err(_) => {
                     bp.moving_dirty = true;
+                    changed = true;
                     break;
                 }
             }
@@ -193,13 +218,15 @@ fn run_broad_phase(
     }
     if bp.moving_dirty {
         bp.moving.clear();
-        bp.moving.extend(moving.iter().map(entry));
+        bp.moving.extend(moving.iter().map(|c| grown(entry(c))));
     }
     if bp.fixed_dirty {
         bp.fixed.clear();
         bp.fixed.extend(fixed.iter().map(entry));
     }
-    bp.find_pairs();
+    if changed {
+        bp.find_pairs();
+    }
 }
 
 type NarrowCollider<'a> = (
