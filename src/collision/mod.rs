@@ -37,6 +37,7 @@
 
 mod broad;
 mod exchange;
+mod fetch;
 mod lanes;
 mod narrow;
 mod plugin;

@@ -7,10 +7,9 @@ use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 
 use super::broad::{BroadPhase, Entry};
 use super::exchange::{Live, SolvedBody, gather, scatter};
+use super::fetch::Wanted;
 use super::narrow::{ContactImpulse, Contacts, PairState, Recycle, choose_points};
-use super::solver::{
-    ContactSolver, EntitySlots, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody,
-};
+use super::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody};
 use super::{
     Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted,
     Friction, Restitution, Sensor,
@@ -230,6 +229,7 @@ fn run_broad_phase(
 }
 
 type NarrowCollider<'a> = (
+    Entity,
     Ref<'a, Collider>,
     &'a Position,
     &'a Rotation,
@@ -242,7 +242,6 @@ type NarrowCollider<'a> = (
 /// What the narrow phase needs of one collider, fetched once per step however many pairs
 /// it is in.
 struct NarrowBody<'a> {
-    entity: Entity,
     collider: &'a Collider,
     pose: Pose,
     /// Fastest speed of any point of the shape (m/s): |v| + |ω| r.
@@ -254,37 +253,31 @@ struct NarrowBody<'a> {
     sensor: bool,
 }
 
-/// Index of `e`'s [`NarrowBody`] in `bodies`, fetched on first use.
 fn narrow_body<'a>(
-    e: Entity,
-    slots: &mut EntitySlots,
-    bodies: &mut Vec<NarrowBody<'a>>,
-    colliders: &'a Query<NarrowCollider, Live>,
-) -> Option<usize> {
-    if let Some(i) = slots.find(e, |i| bodies.get(i).map(|b| b.entity)) {
-        return Some(i as usize);
-    }
-    let (collider, x, q, com, v, w, sensor) = colliders.get(e).ok()?;
+    (_, collider, x, q, com, v, w, sensor): bevy_ecs::query::ROQueryItem<'a, '_, NarrowCollider>,
+) -> NarrowBody<'a> {
     let changed = collider.is_changed();
     let collider = collider.into_inner();
     let [lo, hi] = collider.local_bounds();
     let speed =
         v.map_or(0.0, |v| v.0.length()) + w.map_or(0.0, |w| w.0.length() * radius(collider, com));
-    slots.insert(e, bodies.len() as u32);
-    bodies.push(NarrowBody {
-        entity: e,
+    NarrowBody {
         collider,
         pose: shape_pose(x.0, q.0, com),
         speed,
         extent: lo.abs().max(hi.abs()).length(),
         changed,
         sensor,
-    });
-    Some(bodies.len() - 1)
+    }
 }
 
-/// The narrow phase's reused buffers: body slots, and the point list of the point choice.
-type NarrowBuffers = (EntitySlots, Vec<(Vec3A, f32, bool)>);
+/// Constraint building's reused buffers: the bodies of the step's contacts, the contact
+/// pairs with their slots among them, and the bodies' sides.
+type PrepareBuffers = (Wanted, Vec<(Entity, Entity, u32, u32)>, Vec<Option<Side>>);
+
+/// The narrow phase's reused buffers: the bodies of the step's pairs, the pairs' slots
+/// among them, and the point list of the point choice.
+type NarrowBuffers = (Wanted, Vec<(u32, u32)>, Vec<(Vec3A, f32, bool)>);
 
 /// Persistent manifolds for every candidate pair; start/end messages.
 #[allow(clippy::too_many_arguments)] // two message writers and the queries of one pass
@@ -299,7 +292,17 @@ fn update_contacts(
     sleeping: Query<(), With<Sleeping>>,
     mut buffers: Local<NarrowBuffers>,
 ) {
-    let (slots, scratch) = &mut *buffers;
+    let (wanted, pair_slots, scratch) = &mut *buffers;
+    wanted.clear();
+    pair_slots.clear();
+    pair_slots.extend(
+        bp.pairs
+            .iter()
+            .map(|&(a, b)| (wanted.slot(a) as u32, wanted.slot(b) as u32)),
+    );
+    let mut bodies: Vec<Option<NarrowBody>> = Vec::new();
+    bodies.resize_with(wanted.len(), || None);
+    wanted.fetch(&colliders, |c| c.0, |i, c| bodies[i] = Some(narrow_body(c)));
     let dt = time.dt();
     contacts.step += 1;
     contacts.woken.clear();
@@ -310,15 +313,10 @@ fn update_contacts(
         // Zero, negative or not a number: no reuse.
         _ => 0.0,
     };
-    let mut bodies = Vec::new();
-    for &(a, b) in &bp.pairs {
-        let (Some(ia), Some(ib)) = (
-            narrow_body(a, slots, &mut bodies, &colliders),
-            narrow_body(b, slots, &mut bodies, &colliders),
-        ) else {
+    for (&(a, b), &(sa, sb)) in bp.pairs.iter().zip(pair_slots.iter()) {
+        let (Some(ca), Some(cb)) = (&bodies[sa as usize], &bodies[sb as usize]) else {
             continue;
         };
-        let (ca, cb) = (&bodies[ia], &bodies[ib]);
         let (pose_a, pose_b) = (&ca.pose, &cb.pose);
         let sensor = ca.sensor || cb.sensor;
         let state = contacts.pairs.entry((a, b)).or_insert_with(PairState::new);
@@ -378,7 +376,6 @@ fn update_contacts(
             }
         }
     }
-    slots.clear(bodies.iter().map(|b| b.entity));
     let mut gone: Vec<_> = contacts
         .pairs
         .iter()
@@ -397,6 +394,7 @@ fn update_contacts(
 }
 
 type PreparedBody<'a> = (
+    Entity,
     &'a Position,
     &'a Rotation,
     Option<&'a CenterOfMass>,
@@ -409,48 +407,95 @@ type PreparedBody<'a> = (
     Has<Sleeping>,
 );
 
-/// Solver index of a collider's body: a new [`SolverBody`] for anything with a velocity,
-/// [`FIXED`] for static colliders.
-fn body_index(
-    solver: &mut ContactSolver,
-    e: Entity,
-    b: &bevy_ecs::query::QueryItem<'_, '_, PreparedBody<'_>>,
-) -> u32 {
-    if let Some(i) = solver.index.get(e, &solver.bodies) {
-        return i;
+/// One side of the step's contacts as constraint building needs it, fetched once per step
+/// however many pairs its body is in.
+struct Side {
+    entity: Entity,
+    /// Solver index, [`FIXED`], or [`Side::UNSET`] until a contact first needs it.
+    index: u32,
+    x: Vec3A,
+    q: Quat,
+    pose: Pose,
+    /// Velocity and angular velocity (zero for a [`FIXED`] side).
+    v: Vec3A,
+    w: Vec3A,
+    friction: f32,
+    restitution: f32,
+    /// What a solver body is made of: mass (none for static colliders), whether the body
+    /// moves (has a velocity and is awake), and inertia.
+    mass: Option<Mass>,
+    moves: bool,
+    inertia: Option<Inertia>,
+}
+
+impl Side {
+    const UNSET: u32 = u32::MAX - 1;
+
+    fn new(
+        (entity, x, q, com, mass, v, inertia, w, friction, restitution, sleeping): bevy_ecs::query::ROQueryItem<'_, '_, PreparedBody>,
+    ) -> Self {
+        Side {
+            entity,
+            index: Side::UNSET,
+            x: x.0,
+            q: q.0,
+            pose: shape_pose(x.0, q.0, com),
+            v: v.map_or(Vec3A::ZERO, |v| v.0),
+            w: w.map_or(Vec3A::ZERO, |w| w.0),
+            friction: friction.0,
+            restitution: restitution.0,
+            mass: mass.copied(),
+            moves: v.is_some() && !sleeping,
+            inertia: inertia.copied(),
+        }
     }
-    let (x, q, _, mass, v, inertia, w, _, _, sleeping) = *b;
+}
+
+/// Solver index of a side's body, made on first use: a new [`SolverBody`] for anything
+/// with a velocity, [`FIXED`] for static colliders (whose velocities then read zero).
+fn body_index(solver: &mut ContactSolver, side: &mut Side) -> u32 {
+    if side.index == Side::UNSET {
+        side.index = new_body(solver, side);
+        if side.index == FIXED {
+            (side.v, side.w) = (Vec3A::ZERO, Vec3A::ZERO);
+        }
+    }
+    side.index
+}
+
+fn new_body(solver: &mut ContactSolver, side: &Side) -> u32 {
     // A sleeping body holds still like a static one until its island wakes; a non-finite
     // one (about to be quarantined) is kept out of the solver altogether.
-    let (Some(mass), Some(v), false) = (mass, v, sleeping) else {
+    let (Some(mass), true) = (side.mass, side.moves) else {
         return FIXED;
     };
-    if !(x.0.is_finite() && v.0.is_finite() && q.0.is_finite()) {
+    let (x, q, v) = (side.x, side.q, side.v);
+    if !(x.is_finite() && v.is_finite() && q.is_finite()) {
         return FIXED;
     }
     // A kinematic body drives its contacts but takes no impulse: zero inverse mass and
     // inertia make every push on it exactly nothing.
     let dynamic = !mass.is_pinned();
-    let (inv_i, i0) = match inertia {
+    let (inv_i, i0) = match side.inertia {
         Some(i) if dynamic && !i.is_infinite() => {
-            let (tensor, inverse) = i.world_tensors(q.0);
+            let (tensor, inverse) = i.world_tensors(q);
             (inverse, tensor)
         }
         _ => (Mat3A::ZERO, Mat3A::ZERO),
     };
     let i = solver.bodies.len() as u32;
     solver.bodies.push(SolverBody {
-        entity: e,
+        entity: side.entity,
         inv_mass: if dynamic { mass.inverse() } else { 0.0 },
         inv_i,
         i0,
-        x0: x.0,
-        q0: q.0,
-        w_in: w.map_or(Vec3A::ZERO, |w| w.0),
+        x0: x,
+        q0: q,
+        w_in: side.w,
         dynamic,
-        isotropic: inertia.is_some_and(Inertia::is_isotropic),
+        isotropic: side.inertia.as_ref().is_some_and(Inertia::is_isotropic),
     });
-    solver.index.insert(e, i);
+    solver.index.insert(side.entity, i);
     i
 }
 
@@ -484,57 +529,6 @@ fn tangent_basis(
     [t0, n.cross(t0)]
 }
 
-/// Turns this step's manifolds into contact constraints.
-/// One side of the step's contacts as constraint building needs it, fetched once per step
-/// however many pairs its body is in.
-struct Side {
-    entity: Entity,
-    /// Solver index, or [`FIXED`].
-    index: u32,
-    x: Vec3A,
-    pose: Pose,
-    /// Velocity and angular velocity (zero for a [`FIXED`] side).
-    v: Vec3A,
-    w: Vec3A,
-    friction: f32,
-    restitution: f32,
-}
-
-/// Index of `e`'s [`Side`] in `sides`, fetched on first use.
-fn side(
-    e: Entity,
-    solver: &mut ContactSolver,
-    slots: &mut EntitySlots,
-    sides: &mut Vec<Side>,
-    bodies: &Query<PreparedBody, (With<Collider>, Live)>,
-) -> Option<usize> {
-    if let Some(i) = slots.find(e, |i| sides.get(i).map(|s| s.entity)) {
-        return Some(i as usize);
-    }
-    let b = bodies.get(e).ok()?;
-    let index = body_index(solver, e, &b);
-    let (v, w) = if index == FIXED {
-        (Vec3A::ZERO, Vec3A::ZERO)
-    } else {
-        (
-            b.4.map_or(Vec3A::ZERO, |v| v.0),
-            b.6.map_or(Vec3A::ZERO, |w| w.0),
-        )
-    };
-    slots.insert(e, sides.len() as u32);
-    sides.push(Side {
-        entity: e,
-        index,
-        x: b.0.0,
-        pose: shape_pose(b.0.0, b.1.0, b.2),
-        v,
-        w,
-        friction: b.7.0,
-        restitution: b.8.0,
-    });
-    Some(sides.len() - 1)
-}
-
 #[allow(clippy::too_many_arguments)] // the step's inputs and its reused buffers
 fn prepare_contacts(
     mut solver: ResMut<ContactSolver>,
@@ -543,12 +537,13 @@ fn prepare_contacts(
     bp: Res<BroadPhase>,
     settings: Res<ContactSettings>,
     bodies: Query<PreparedBody, (With<Collider>, Live)>,
-    mut buffers: Local<(EntitySlots, Vec<Side>)>,
+    mut buffers: Local<PrepareBuffers>,
 ) {
     let s = &mut *solver;
     s.clear();
-    let (slots, sides) = &mut *buffers;
-    sides.clear();
+    let (wanted, pairs, sides) = &mut *buffers;
+    wanted.clear();
+    pairs.clear();
     for &(ea, eb) in bp.pairs.iter().chain(&contacts.woken) {
         let Some(state) = contacts.pairs.get(&(ea, eb)) else {
             continue;
@@ -556,17 +551,28 @@ fn prepare_contacts(
         if state.sensor || state.manifolds.iter().all(|m| m.points.is_empty()) {
             continue;
         }
-        let (Some(a), Some(b)) = (
-            side(ea, s, slots, sides, &bodies),
-            side(eb, s, slots, sides, &bodies),
-        ) else {
+        pairs.push((ea, eb, wanted.slot(ea) as u32, wanted.slot(eb) as u32));
+    }
+    sides.clear();
+    sides.resize_with(wanted.len(), || None);
+    wanted.fetch(&bodies, |b| b.0, |i, b| sides[i] = Some(Side::new(b)));
+    for &(ea, eb, sa, sb) in pairs.iter() {
+        let Some(state) = contacts.pairs.get(&(ea, eb)) else {
             continue;
         };
-        let (a, b) = (&sides[a], &sides[b]);
-        let (ia, ib) = (a.index, b.index);
+        let (sa, sb) = (sa as usize, sb as usize);
+        if sides[sa].is_none() || sides[sb].is_none() {
+            continue;
+        }
+        // Solver bodies are numbered in the order contacts first need them.
+        let ia = sides[sa].as_mut().map_or(FIXED, |a| body_index(s, a));
+        let ib = sides[sb].as_mut().map_or(FIXED, |b| body_index(s, b));
         if ia == FIXED && ib == FIXED {
             continue;
         }
+        let (Some(a), Some(b)) = (&sides[sa], &sides[sb]) else {
+            continue;
+        };
         let ((va, wa), (vb, wb)) = ((a.v, a.w), (b.v, b.w));
         let (pose_a, pose_b) = (&a.pose, &b.pose);
         let friction = settings.friction_rule.combine(a.friction, b.friction);
@@ -631,7 +637,6 @@ fn prepare_contacts(
             });
         }
     }
-    slots.clear(sides.iter().map(|s| s.entity));
     s.build();
     active.0 = !s.manifolds.is_empty();
 }
