@@ -175,9 +175,10 @@ fn entry(
 /// when colliders were added, removed or quarantined.
 ///
 /// The broad phase holds each moving box grown by a tenth of the margin, and keeps it while
-/// the collider's box stays inside and no face is twice that far in: a resting body then changes nothing, and when no box
-/// changed the last step's pairs still hold and the sweep is skipped. The pairs are those of
-/// the grown boxes, a superset of the exact ones that the narrow phase sorts out.
+/// the collider's box stays inside and no face is twice that far in: a resting body then
+/// changes nothing, and when no box changed the last step's pairs still hold and the sweep
+/// is skipped. The pairs are those of the grown boxes, a superset of the exact ones that the
+/// narrow phase sorts out.
 fn run_broad_phase(
     mut bp: ResMut<BroadPhase>,
     settings: Res<ContactSettings>,
@@ -431,9 +432,8 @@ struct Side {
 impl Side {
     const UNSET: u32 = u32::MAX - 1;
 
-    fn new(
-        (entity, x, q, com, mass, v, inertia, w, friction, restitution, sleeping): bevy_ecs::query::ROQueryItem<'_, '_, PreparedBody>,
-    ) -> Self {
+    fn new(body: bevy_ecs::query::ROQueryItem<'_, '_, PreparedBody>) -> Self {
+        let (entity, x, q, com, mass, v, inertia, w, friction, restitution, sleeping) = body;
         Side {
             entity,
             index: Side::UNSET,
