@@ -491,6 +491,7 @@ fn new_body(solver: &mut ContactSolver, side: &Side) -> u32 {
         i0,
         x0: x,
         q0: q,
+        q_seen: q,
         w_in: side.w,
         dynamic,
         isotropic: side.inertia.as_ref().is_some_and(Inertia::is_isotropic),

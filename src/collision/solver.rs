@@ -47,6 +47,8 @@ pub(crate) struct SolverBody {
     /// Centre of mass and rotation at the start of the step.
     pub x0: Vec3A,
     pub q0: Quat,
+    /// The rotation at which the state's ΔR was last formed.
+    pub q_seen: Quat,
     /// Angular velocity when the current pass began: the pass's change of ω, times the
     /// inertia, is the angular impulse it applied.
     pub w_in: Vec3A,

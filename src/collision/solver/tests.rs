@@ -57,6 +57,7 @@ fn solver_with(bodies: usize, pairs: &[(u32, u32)]) -> ContactSolver {
             i0: Mat3A::ZERO,
             x0: Vec3A::ZERO,
             q0: Quat::IDENTITY,
+            q_seen: Quat::IDENTITY,
             w_in: Vec3A::ZERO,
             dynamic: true,
             isotropic: false,
