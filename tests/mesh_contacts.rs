@@ -32,7 +32,11 @@ fn rests_flat(ground: Collider) -> (f32, f32) {
         w.step_physics();
     }
     let y = common::x(&w, cube).y;
-    let tilt = w.get::<Rotation>(cube).unwrap().0.angle_between(Quat::IDENTITY);
+    let tilt = w
+        .get::<Rotation>(cube)
+        .unwrap()
+        .0
+        .angle_between(Quat::IDENTITY);
     (y, tilt)
 }
 
