@@ -261,18 +261,9 @@ mod tests {
         let mut solver = ContactSolver::default();
         for &e in &entities[2..] {
             let i = solver.bodies.len() as u32;
-            solver.bodies.push(SolverBody {
-                entity: e,
-                inv_mass: 1.0,
-                inv_i: Mat3A::IDENTITY,
-                i0: Mat3A::IDENTITY,
-                x0: Vec3A::ZERO,
-                q0: Quat::IDENTITY,
-                q_seen: Quat::IDENTITY,
-                w_in: Vec3A::ZERO,
-                dynamic: true,
-                isotropic: false,
-            });
+            solver
+                .bodies
+                .push(SolverBody::at_origin(e, 1.0, Mat3A::IDENTITY));
             solver.index.insert(e, i);
         }
         solver.states = vec![BodyState::REST; solver.bodies.len() + 1];
@@ -349,18 +340,9 @@ mod tests {
         }
         let e = body(&mut world, 99);
         let mut solver = ContactSolver::default();
-        solver.bodies.push(SolverBody {
-            entity: e,
-            inv_mass: 1.0,
-            inv_i: Mat3A::IDENTITY,
-            i0: Mat3A::IDENTITY,
-            x0: Vec3A::ZERO,
-            q0: Quat::IDENTITY,
-            q_seen: Quat::IDENTITY,
-            w_in: Vec3A::ZERO,
-            dynamic: true,
-            isotropic: false,
-        });
+        solver
+            .bodies
+            .push(SolverBody::at_origin(e, 1.0, Mat3A::IDENTITY));
         solver.index.insert(e, 0);
         solver.states = vec![BodyState::REST; 2];
         world.insert_resource(solver);

@@ -58,6 +58,25 @@ pub(crate) struct SolverBody {
     pub isotropic: bool,
 }
 
+#[cfg(test)]
+impl SolverBody {
+    /// A dynamic body at the origin, unturned, for tests.
+    pub fn at_origin(entity: Entity, inv_mass: f32, inv_i: Mat3A) -> Self {
+        Self {
+            entity,
+            inv_mass,
+            inv_i,
+            i0: inv_i,
+            x0: Vec3A::ZERO,
+            q0: Quat::IDENTITY,
+            q_seen: Quat::IDENTITY,
+            w_in: Vec3A::ZERO,
+            dynamic: true,
+            isotropic: false,
+        }
+    }
+}
+
 /// The velocity state of one body during a pass.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct BodyState {

@@ -50,18 +50,11 @@ fn effective_mass_of_a_point_mass_and_a_lever() {
 fn solver_with(bodies: usize, pairs: &[(u32, u32)]) -> ContactSolver {
     let mut s = ContactSolver::default();
     for i in 0..bodies {
-        s.bodies.push(SolverBody {
-            entity: Entity::from_raw_u32(i as u32 + 1).unwrap(),
-            inv_mass: 1.0 / (1.0 + i as f32),
-            inv_i: Mat3A::ZERO,
-            i0: Mat3A::ZERO,
-            x0: Vec3A::ZERO,
-            q0: Quat::IDENTITY,
-            q_seen: Quat::IDENTITY,
-            w_in: Vec3A::ZERO,
-            dynamic: true,
-            isotropic: false,
-        });
+        s.bodies.push(SolverBody::at_origin(
+            Entity::from_raw_u32(i as u32 + 1).unwrap(),
+            1.0 / (1.0 + i as f32),
+            Mat3A::ZERO,
+        ));
     }
     for (mi, &(a, b)) in pairs.iter().enumerate() {
         s.manifolds.push(ManifoldConstraint {
