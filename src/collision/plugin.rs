@@ -47,7 +47,7 @@ impl Plugin for CollisionPlugin {
                 prepare_contacts,
             )
                 .chain()
-                .run_if(any_with_component::<Collider>)
+                .run_if(any_with_component::<Collider>.or_else(has_contacts))
                 .in_set(PrepareSystems::Collision),
         );
         add_systems(
@@ -67,6 +67,13 @@ impl Plugin for CollisionPlugin {
 
 fn contacts_active(solver: Res<ContactSolver>) -> bool {
     !solver.manifolds.is_empty()
+}
+
+/// Contacts or constraints are left from a step that had colliders: the collision systems
+/// run once more after the last collider goes, so that its pairs end (with their events)
+/// and the solver drops their constraints.
+fn has_contacts(solver: Res<ContactSolver>, contacts: Res<Contacts>) -> bool {
+    !solver.manifolds.is_empty() || !contacts.pairs.is_empty()
 }
 
 /// The second part's pose in the first part's frame, from the second shape's pose in the
