@@ -549,8 +549,8 @@ impl ContactSolver {
     }
 
     #[inline]
-    fn load(&self, ix: [u32; 4], inv_m: F4) -> Side {
-        let s = ix.map(|i| &self.states[i as usize]);
+    fn load(states: &[BodyState], ix: [u32; 4], inv_m: F4) -> Side {
+        let s = ix.map(|i| &states[i as usize]);
         Side {
             v: V3::from_lanes(s.map(|s| s.v)),
             w: V3::from_lanes(s.map(|s| s.w)),
@@ -558,13 +558,13 @@ impl ContactSolver {
         }
     }
 
+    /// Writes a side back, except into the rest state (`rest`), which stays at rest.
     #[inline]
-    fn store(&mut self, ix: [u32; 4], side: &Side) {
-        let rest = self.rest();
+    fn store(states: &mut [BodyState], rest: u32, ix: [u32; 4], side: &Side) {
         let (v, w) = (side.v.lanes(), side.w.lanes());
         for l in 0..4 {
             if ix[l] != rest {
-                let s = &mut self.states[ix[l] as usize];
+                let s = &mut states[ix[l] as usize];
                 s.v = v[l];
                 s.w = w[l];
             }
@@ -573,8 +573,8 @@ impl ContactSolver {
 
     /// Δx and ΔR of both sides, for the current separations.
     #[inline]
-    fn motion(&self, ix: [u32; 4]) -> (V3, M3) {
-        let s = ix.map(|i| &self.states[i as usize]);
+    fn motion(states: &[BodyState], ix: [u32; 4]) -> (V3, M3) {
+        let s = ix.map(|i| &states[i as usize]);
         (
             V3::from_lanes(s.map(|s| s.dx)),
             M3::from_lanes(s.map(|s| &s.dr)),
@@ -583,18 +583,27 @@ impl ContactSolver {
 
     /// Applies every accumulated impulse once (warm start).
     pub fn warm_start(&mut self) {
-        for bi in 0..self.batches.len() {
-            let batch = self.batches[bi];
+        let rest = self.rest();
+        // Borrowed field by field: a batch is a few hundred bytes, and copying it out of
+        // `self` for each pass cost a memcpy call per batch.
+        let Self {
+            batches,
+            points,
+            states,
+            friction,
+            ..
+        } = self;
+        for (batch, friction) in batches.iter().zip(friction.iter_mut()) {
             let (mut a, mut b) = (
-                self.load(batch.a, batch.inv_m_a),
-                self.load(batch.b, batch.inv_m_b),
+                Self::load(states, batch.a, batch.inv_m_a),
+                Self::load(states, batch.b, batch.inv_m_b),
             );
-            for p in &self.points[batch.first as usize..(batch.first + batch.count) as usize] {
+            for p in &points[batch.first as usize..(batch.first + batch.count) as usize] {
                 Side::push(&mut a, &mut b, batch.n, &p.normal, p.n_imp);
             }
-            self.friction[bi].warm_start(&batch, &mut a, &mut b);
-            self.store(batch.a, &a);
-            self.store(batch.b, &b);
+            friction.warm_start(batch, &mut a, &mut b);
+            Self::store(states, rest, batch.a, &a);
+            Self::store(states, rest, batch.b, &b);
         }
     }
 
@@ -621,14 +630,21 @@ impl ContactSolver {
         let inv_h = F4::splat(1.0 / h);
         let max_push = F4::splat(-max_push);
         let (zero, one) = (F4::ZERO, F4::ONE);
-        for bi in 0..self.batches.len() {
-            let batch = self.batches[bi];
+        let rest = self.rest();
+        let Self {
+            batches,
+            points,
+            states,
+            friction,
+            ..
+        } = self;
+        for (batch, friction) in batches.iter().zip(friction.iter_mut()) {
             let (mut a, mut b) = (
-                self.load(batch.a, batch.inv_m_a),
-                self.load(batch.b, batch.inv_m_b),
+                Self::load(states, batch.a, batch.inv_m_a),
+                Self::load(states, batch.b, batch.inv_m_b),
             );
-            let (dx_a, dr_a) = self.motion(batch.a);
-            let (dx_b, dr_b) = self.motion(batch.b);
+            let (dx_a, dr_a) = Self::motion(states, batch.a);
+            let (dx_b, dr_b) = Self::motion(states, batch.b);
             let pick = |f: fn(&Softness) -> f32| {
                 batch
                     .fixed
@@ -672,18 +688,16 @@ impl ContactSolver {
                 p.max_n = p.max_n.fast_max(imp);
                 Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
             };
-            let points = &mut self.points[range.clone()];
+            let points = &mut points[range];
             if use_bias {
                 points.iter_mut().for_each(&mut visit);
             } else {
                 points.iter_mut().rev().for_each(&mut visit);
+                let normal = points.iter().fold(F4::ZERO, |s, p| s + p.n_imp);
+                friction.solve(batch, normal, &mut a, &mut b);
             }
-            if !use_bias {
-                let normal = self.points[range].iter().fold(F4::ZERO, |s, p| s + p.n_imp);
-                self.friction[bi].solve(&batch, normal, &mut a, &mut b);
-            }
-            self.store(batch.a, &a);
-            self.store(batch.b, &b);
+            Self::store(states, rest, batch.a, &a);
+            Self::store(states, rest, batch.b, &b);
         }
     }
 
@@ -692,17 +706,23 @@ impl ContactSolver {
     pub fn restitution(&mut self, threshold: f32) {
         let zero = F4::ZERO;
         let threshold = F4::splat(-threshold);
-        for bi in 0..self.batches.len() {
-            let batch = self.batches[bi];
+        let rest = self.rest();
+        let Self {
+            batches,
+            points,
+            states,
+            ..
+        } = self;
+        for batch in batches.iter() {
             let bouncy = batch.restitution.simd_gt(zero);
             if !bouncy.any() {
                 continue;
             }
             let (mut a, mut b) = (
-                self.load(batch.a, batch.inv_m_a),
-                self.load(batch.b, batch.inv_m_b),
+                Self::load(states, batch.a, batch.inv_m_a),
+                Self::load(states, batch.b, batch.inv_m_b),
             );
-            for p in &mut self.points[batch.first as usize..(batch.first + batch.count) as usize] {
+            for p in &mut points[batch.first as usize..(batch.first + batch.count) as usize] {
                 let hit = bouncy & p.approach.simd_lt(threshold) & p.max_n.simd_gt(zero);
                 if !hit.any() {
                     continue;
@@ -714,8 +734,8 @@ impl ContactSolver {
                 p.n_imp = total;
                 Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
             }
-            self.store(batch.a, &a);
-            self.store(batch.b, &b);
+            Self::store(states, rest, batch.a, &a);
+            Self::store(states, rest, batch.b, &b);
         }
     }
 
