@@ -581,11 +581,15 @@ impl ContactSolver {
         )
     }
 
-    /// Applies every accumulated impulse once (warm start).
-    pub fn warm_start(&mut self) {
+    /// Runs `f` on every batch with both sides loaded, then stores the sides back. Borrows
+    /// field by field: a batch is a few hundred bytes, and copying it out of `self` for
+    /// each pass cost a memcpy call per batch.
+    #[inline(always)]
+    fn for_each_batch(
+        &mut self,
+        mut f: impl FnMut(&Batch, &mut friction::Friction, &mut [Point], &[BodyState], &mut [Side; 2]),
+    ) {
         let rest = self.rest();
-        // Borrowed field by field: a batch is a few hundred bytes, and copying it out of
-        // `self` for each pass cost a memcpy call per batch.
         let Self {
             batches,
             points,
@@ -594,17 +598,25 @@ impl ContactSolver {
             ..
         } = self;
         for (batch, friction) in batches.iter().zip(friction.iter_mut()) {
-            let (mut a, mut b) = (
+            let mut sides = [
                 Self::load(states, batch.a, batch.inv_m_a),
                 Self::load(states, batch.b, batch.inv_m_b),
-            );
-            for p in &points[batch.first as usize..(batch.first + batch.count) as usize] {
-                Side::push(&mut a, &mut b, batch.n, &p.normal, p.n_imp);
-            }
-            friction.warm_start(batch, &mut a, &mut b);
-            Self::store(states, rest, batch.a, &a);
-            Self::store(states, rest, batch.b, &b);
+            ];
+            let range = batch.first as usize..(batch.first + batch.count) as usize;
+            f(batch, friction, &mut points[range], states, &mut sides);
+            Self::store(states, rest, batch.a, &sides[0]);
+            Self::store(states, rest, batch.b, &sides[1]);
         }
+    }
+
+    /// Applies every accumulated impulse once (warm start).
+    pub fn warm_start(&mut self) {
+        self.for_each_batch(|batch, friction, points, _, [a, b]| {
+            for p in points.iter() {
+                Side::push(a, b, batch.n, &p.normal, p.n_imp);
+            }
+            friction.warm_start(batch, a, b);
+        });
     }
 
     /// One pass over every contact: normal impulses, with the soft bias when `use_bias`;
@@ -627,22 +639,26 @@ impl ContactSolver {
         use_bias: bool,
         max_push: f32,
     ) {
+        // One copy of the pass per kind, so that neither tests the kind per point.
+        if use_bias {
+            self.solve_pass::<true>(h, soft, fixed_soft, max_push);
+        } else {
+            self.solve_pass::<false>(h, soft, fixed_soft, max_push);
+        }
+    }
+
+    fn solve_pass<const BIAS: bool>(
+        &mut self,
+        h: f32,
+        soft: Softness,
+        fixed_soft: Softness,
+        max_push: f32,
+    ) {
+        let use_bias = BIAS;
         let inv_h = F4::splat(1.0 / h);
         let max_push = F4::splat(-max_push);
         let (zero, one) = (F4::ZERO, F4::ONE);
-        let rest = self.rest();
-        let Self {
-            batches,
-            points,
-            states,
-            friction,
-            ..
-        } = self;
-        for (batch, friction) in batches.iter().zip(friction.iter_mut()) {
-            let (mut a, mut b) = (
-                Self::load(states, batch.a, batch.inv_m_a),
-                Self::load(states, batch.b, batch.inv_m_b),
-            );
+        self.for_each_batch(|batch, friction, points, states, [a, b]| {
             let (dx_a, dr_a) = Self::motion(states, batch.a);
             let (dx_b, dr_b) = Self::motion(states, batch.b);
             let pick = |f: fn(&Softness) -> f32| {
@@ -665,14 +681,13 @@ impl ContactSolver {
                 dr_b.transpose_mul_vec(batch.n),
             );
             let shift = batch.n.dot(dx_b - dx_a);
-            let range = batch.first as usize..(batch.first + batch.count) as usize;
             let mut visit = |p: &mut Point| {
                 let s = (shift + (turn_b.dot(p.r_b) - turn_a.dot(p.r_a))) + p.base;
                 let speculative = s.simd_gt(zero);
                 let bias = speculative.select(s * inv_h, (bias_rate * s).fast_max(max_push));
                 let m_scale = speculative.select(one, mass_scale);
                 let i_scale = speculative.select(zero, impulse_scale);
-                let vn = batch.n.dot(Side::relative(&a, &b, p.r_a, p.r_b));
+                let vn = batch.n.dot(Side::relative(a, b, p.r_a, p.r_b));
                 if use_bias {
                     p.vn_seen = [p.vn_seen[1], vn];
                 }
@@ -686,19 +701,16 @@ impl ContactSolver {
                 }
                 p.n_imp = total;
                 p.max_n = p.max_n.fast_max(imp);
-                Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
+                Side::push(a, b, batch.n, &p.normal, imp);
             };
-            let points = &mut points[range];
             if use_bias {
                 points.iter_mut().for_each(&mut visit);
             } else {
                 points.iter_mut().rev().for_each(&mut visit);
                 let normal = points.iter().fold(F4::ZERO, |s, p| s + p.n_imp);
-                friction.solve(batch, normal, &mut a, &mut b);
+                friction.solve(batch, normal, a, b);
             }
-            Self::store(states, rest, batch.a, &a);
-            Self::store(states, rest, batch.b, &b);
-        }
+        });
     }
 
     /// After the last substep: contacts that hit faster than `threshold` leave at −e times
