@@ -654,7 +654,6 @@ impl ContactSolver {
         fixed_soft: Softness,
         max_push: f32,
     ) {
-        let use_bias = BIAS;
         let inv_h = F4::splat(1.0 / h);
         let max_push = F4::splat(-max_push);
         let (zero, one) = (F4::ZERO, F4::ONE);
@@ -666,7 +665,7 @@ impl ContactSolver {
                     .fixed
                     .select(F4::splat(f(&fixed_soft)), F4::splat(f(&soft)))
             };
-            let (bias_rate, mass_scale, impulse_scale) = if use_bias {
+            let (bias_rate, mass_scale, impulse_scale) = if BIAS {
                 (
                     pick(|s| s.bias_rate),
                     pick(|s| s.mass_scale),
@@ -688,7 +687,7 @@ impl ContactSolver {
                 let m_scale = speculative.select(one, mass_scale);
                 let i_scale = speculative.select(zero, impulse_scale);
                 let vn = batch.n.dot(Side::relative(a, b, p.r_a, p.r_b));
-                if use_bias {
+                if BIAS {
                     p.vn_seen = [p.vn_seen[1], vn];
                 }
                 let imp = -p.normal.mass * m_scale * (vn + bias) - i_scale * p.n_imp;
@@ -703,7 +702,7 @@ impl ContactSolver {
                 p.max_n = p.max_n.fast_max(imp);
                 Side::push(a, b, batch.n, &p.normal, imp);
             };
-            if use_bias {
+            if BIAS {
                 points.iter_mut().for_each(&mut visit);
             } else {
                 points.iter_mut().rev().for_each(&mut visit);
