@@ -7,15 +7,11 @@ use glam::Vec3;
 use hooke::prelude::*;
 use hooke::{Sleeping, scenes};
 
+mod common;
+
 #[test]
 fn a_ball_fired_at_a_sleeping_box_hands_over_its_momentum_in_the_step_of_impact() {
-    let mut w = scenes::world_with(
-        1.0 / 60.0,
-        4,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -9.81, 0.0),
-    )
-    .unwrap();
+    let mut w = common::gravity_world(4);
     let ground = scenes::ground(&mut w).unwrap();
     let target = scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::new(0.0, 0.5, 0.0)).unwrap();
     let ball = scenes::dynamic_ball(&mut w, 0.5, Vec3::new(-3.0, 0.5, 0.0)).unwrap();
@@ -60,13 +56,7 @@ fn a_ball_fired_at_a_sleeping_box_hands_over_its_momentum_in_the_step_of_impact(
 
 #[test]
 fn the_whole_island_wakes_in_the_step_of_impact_and_keeps_its_support() {
-    let mut w = scenes::world_with(
-        1.0 / 60.0,
-        4,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -9.81, 0.0),
-    )
-    .unwrap();
+    let mut w = common::gravity_world(4);
     scenes::ground(&mut w).unwrap();
     let bottom = scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::new(0.0, 0.5, 0.0)).unwrap();
     let top = scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::new(0.0, 1.5, 0.0)).unwrap();

@@ -29,13 +29,7 @@ fn schedules_have_no_ambiguities() {
 }
 
 fn run_showcase(steps: usize) -> Vec<u32> {
-    let mut world = scenes::world_with(
-        1.0 / 60.0,
-        4,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -9.81, 0.0),
-    )
-    .unwrap();
+    let mut world = common::gravity_world(4);
     scenes::showcase(&mut world).unwrap();
     scenes::cloth(&mut world, 10).unwrap();
     for _ in 0..steps {
@@ -67,13 +61,7 @@ fn same_inputs_give_bit_identical_results() {
 /// The pile scene with sleeping on: coloured SIMD contact batches, four-point manifolds,
 /// islands falling asleep, and a late ball that wakes them within the step.
 fn run_pile(steps: usize) -> (Vec<u32>, usize) {
-    let mut world = scenes::world_with(
-        1.0 / 60.0,
-        4,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -9.81, 0.0),
-    )
-    .unwrap();
+    let mut world = common::gravity_world(4);
     let (boxes, _) = scenes::pile_scene(&mut world, 40, 10).unwrap();
     let mut slept = 0;
     for step in 0..steps {

@@ -5,14 +5,10 @@ use glam::Vec3;
 use hooke::prelude::*;
 use hooke::{SleepSettings, Sleeping, SleepingDisabled, scenes};
 
+mod common;
+
 fn world() -> World {
-    scenes::world_with(
-        1.0 / 60.0,
-        4,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -9.81, 0.0),
-    )
-    .unwrap()
+    common::gravity_world(4)
 }
 
 fn asleep(w: &World, e: Entity) -> bool {

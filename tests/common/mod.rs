@@ -29,16 +29,22 @@ pub fn oscillator_energy(world: &World, e: Entity) -> f64 {
     0.5 * v * v + 0.5 * k * x * x
 }
 
-/// A contact test's world: dt 1/60 s, symplectic Euler, g = 9.81 m/s² down, sleeping off
-/// (so that nothing the test watches stops moving on its own).
-pub fn contact_world(substeps: u32) -> World {
-    let mut w = scenes::world_with(
+/// A world of falling things: dt 1/60 s, symplectic Euler, g = 9.81 m/s² down, default
+/// sleeping.
+pub fn gravity_world(substeps: u32) -> World {
+    scenes::world_with(
         1.0 / 60.0,
         substeps,
         Integrator::SymplecticEuler,
         Vec3::new(0.0, -9.81, 0.0),
     )
-    .unwrap();
+    .unwrap()
+}
+
+/// A contact test's world: [`gravity_world`] with sleeping off (so that nothing the test
+/// watches stops moving on its own).
+pub fn contact_world(substeps: u32) -> World {
+    let mut w = gravity_world(substeps);
     w.resource_mut::<hooke::SleepSettings>().enabled = false;
     w
 }
