@@ -21,7 +21,8 @@ use crate::particles::{Gravity, LinearVelocity, Mass, Nodes, Position, Tracer};
 use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, rotational_energy};
 use crate::schedule::{
-    PhysicsSchedule, PhysicsSystems, ProbeSystems, StepSystems, SubstepSchedule, add_systems,
+    FinishSystems, PhysicsSchedule, PhysicsSystems, ProbeSystems, StepSystems, SubstepSchedule,
+    add_systems,
 };
 use crate::springs::{Endpoint, Spinning, Spring, SpringNetwork, anchor_state, spring_energy};
 
@@ -151,7 +152,7 @@ pub(crate) fn install(world: &mut World) {
                 measure_energy.run_if(|s: Res<DiagnosticsSettings>| s.energy),
             )
                 .chain()
-                .in_set(PhysicsSystems::Finish),
+                .in_set(FinishSystems::Diagnostics),
         ),
     );
 }

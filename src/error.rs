@@ -61,6 +61,12 @@ pub enum Error {
     /// A shape has no volume (flat, open or a heightfield), so it has no mass to simulate.
     #[error("shape {0} has no volume, so it has no mass; give explicit mass properties")]
     ZeroVolume(String),
+    /// A compound's part (or a body's child collider) is itself composite: a compound,
+    /// triangle mesh or heightfield, which parry cannot nest.
+    #[error(
+        "a {0} cannot be part of a compound (parry does not nest composite shapes); use convex parts"
+    )]
+    CompositePart(String),
     /// An index into a mesh's node arrays was out of range.
     #[error("{what} index {index} is out of range for {len} nodes")]
     IndexOutOfRange {

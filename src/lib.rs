@@ -46,6 +46,8 @@
 
 #![warn(missing_docs)]
 
+#[cfg(feature = "bevy")]
+pub mod bevy;
 pub mod collision;
 pub mod diagnostics;
 pub mod error;
@@ -63,7 +65,8 @@ use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 
 pub use collision::{
-    Collider, CollisionLayers, CollisionPlugin, CombineRule, ContactEnded, ContactSettings,
+    Collider, ColliderDensity, ColliderOf, ColliderOffset, CollisionEventsEnabled, CollisionLayers,
+    CollisionPlugin, CombineRule, ContactEnd, ContactEnded, ContactSettings, ContactStart,
     ContactStarted, Contacts, Friction, Restitution, Sensor, SpatialQuery,
 };
 pub use diagnostics::{DiagnosticsSettings, PhysicsDiagnostics};
@@ -94,8 +97,8 @@ pub mod prelude {
         Advection, BodyQuarantined, ChainBuilder, ClothBuilder, DiagnosticsSettings, Error,
         ExternalForce, ExternalImpulse, Force, Gravity, GravityScale, Integrator,
         IntegratorOverride, LinearDamping, LinearVelocity, Mass, Nodes, ParticleBundle,
-        PhysicsDiagnostics, PhysicsPlugins, PhysicsTime, PhysicsWorldExt, Plugin, Position,
-        QuarantineReason, Quarantined, Spring, SpringNetwork, Tracer, VelocityField,
+        PhysicsDiagnostics, PhysicsPlugins, PhysicsTime, PhysicsWorldExt, Position,
+        QuarantineReason, Quarantined, Spring, SpringNetwork, Tracer, VelocityField, WorldPlugin,
     };
     pub use crate::{
         AngularVelocity, Collider, CollisionLayers, Contacts, Friction, Inertia, MassProperties,
@@ -105,7 +108,7 @@ pub mod prelude {
 }
 
 /// A piece of physics that installs itself into a `World`: resources and systems.
-pub trait Plugin: 'static {
+pub trait WorldPlugin: 'static {
     /// Adds the plugin's resources and systems. Called once per world.
     fn build(&self, world: &mut World);
 }
@@ -119,7 +122,7 @@ struct InstalledPlugins(Vec<core::any::TypeId>);
 #[derive(Debug, Default, Clone, Copy)]
 pub struct PhysicsCorePlugin;
 
-impl Plugin for PhysicsCorePlugin {
+impl WorldPlugin for PhysicsCorePlugin {
     fn build(&self, world: &mut World) {
         schedule::init_schedules(world);
         if !world.contains_resource::<PhysicsTime>() {
@@ -142,7 +145,7 @@ impl Plugin for PhysicsCorePlugin {
 #[derive(Debug, Default, Clone, Copy)]
 pub struct PhysicsPlugins;
 
-impl Plugin for PhysicsPlugins {
+impl WorldPlugin for PhysicsPlugins {
     fn build(&self, world: &mut World) {
         world
             .add_physics(GravityPlugin)
@@ -159,7 +162,7 @@ impl Plugin for PhysicsPlugins {
 pub trait PhysicsWorldExt {
     /// Builds `plugin` into this world (once; later calls with the same plugin do nothing).
     /// The core plugin is added first if missing.
-    fn add_physics<P: Plugin>(&mut self, plugin: P) -> &mut Self;
+    fn add_physics<P: WorldPlugin>(&mut self, plugin: P) -> &mut Self;
 
     /// Runs one fixed step of [`PhysicsTime::dt`]. Does nothing without the core plugin.
     fn step_physics(&mut self);
@@ -172,7 +175,7 @@ pub trait PhysicsWorldExt {
     fn advance_physics(&mut self, frame_dt: f32) -> Result<FrameReport>;
 }
 
-fn mark_installed<P: Plugin>(world: &mut World) -> bool {
+fn mark_installed<P: WorldPlugin>(world: &mut World) -> bool {
     let id = core::any::TypeId::of::<P>();
     let mut installed = world.get_resource_or_init::<InstalledPlugins>();
     if installed.0.contains(&id) {
@@ -196,7 +199,7 @@ fn rotate_messages(world: &mut World) {
     }
 }
 
-fn run_step(world: &mut World) {
+pub(crate) fn run_step(world: &mut World) {
     let start = std::time::Instant::now();
     let _ = world.try_run_schedule(PhysicsSchedule);
     if let Some(mut d) = world.get_resource_mut::<PhysicsDiagnostics>() {
@@ -205,7 +208,7 @@ fn run_step(world: &mut World) {
 }
 
 impl PhysicsWorldExt for World {
-    fn add_physics<P: Plugin>(&mut self, plugin: P) -> &mut Self {
+    fn add_physics<P: WorldPlugin>(&mut self, plugin: P) -> &mut Self {
         if mark_installed::<PhysicsCorePlugin>(self) {
             PhysicsCorePlugin.build(self);
         }

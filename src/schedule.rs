@@ -4,7 +4,7 @@
 //! PhysicsSchedule            one fixed step of length dt
 //!   PhysicsSystems::Prepare    drop broken springs, derived data
 //!   PhysicsSystems::Step       runs SubstepSchedule `substeps` times, h = dt / substeps
-//!   PhysicsSystems::Finish     diagnostics
+//!   PhysicsSystems::Finish     attached colliders' poses, then diagnostics
 //!
 //! SubstepSchedule            one substep of length h
 //!   StepSystems::ClearForces        f ← constant forces: external + m g s
@@ -130,6 +130,16 @@ pub enum PrepareSystems {
     Collision,
 }
 
+/// The stages of [`PhysicsSystems::Finish`]: derived poses first (colliders attached to
+/// bodies), then diagnostics, which read them.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum FinishSystems {
+    /// Poses derived from the step's result.
+    Writeback,
+    /// Energies, momenta, counts, timings.
+    Diagnostics,
+}
+
 /// Timing probes between the step sets; probe k runs just before `StepSystems::ORDER[k]`.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub(crate) struct ProbeSystems(pub u8);
@@ -167,6 +177,11 @@ pub(crate) fn init_schedules(world: &mut World) {
         )
             .chain()
             .in_set(PhysicsSystems::Prepare),
+    );
+    physics.configure_sets(
+        (FinishSystems::Writeback, FinishSystems::Diagnostics)
+            .chain()
+            .in_set(PhysicsSystems::Finish),
     );
 
     let mut substep = new_schedule(SubstepSchedule, false);

@@ -21,7 +21,7 @@ use bevy_platform::collections::HashMap;
 
 use bevy_ecs::prelude::*;
 
-use crate::Plugin;
+use crate::WorldPlugin;
 use crate::collision::{Collider, ContactSettings, Contacts};
 use crate::particles::{ExternalForce, ExternalImpulse, LinearVelocity, Mass, Position};
 use crate::quarantine::Quarantined;
@@ -73,7 +73,7 @@ impl Default for SleepSettings {
 #[derive(Debug, Default, Clone, Copy)]
 pub struct SleepPlugin;
 
-impl Plugin for SleepPlugin {
+impl WorldPlugin for SleepPlugin {
     fn build(&self, world: &mut World) {
         world.init_resource::<SleepSettings>();
         add_systems(
@@ -242,6 +242,13 @@ struct IslandScratch {
     island_still: Vec<bool>,
 }
 
+/// Colliders that sleep on their own: not quarantined, not a part of another body.
+type SleepFilter = (
+    With<Collider>,
+    Without<Quarantined>,
+    Without<crate::ColliderOf>,
+);
+
 /// Timers, islands, and the sleep/wake decisions.
 #[allow(clippy::too_many_arguments)] // system parameters: queries, resources and a Local
 fn update_islands(
@@ -251,7 +258,7 @@ fn update_islands(
     contacts: Res<Contacts>,
     springs: Query<&Spring>,
     sleepers: Query<Entity, With<Sleeping>>,
-    mut bodies: Query<SleepBody, (With<Collider>, Without<Quarantined>)>,
+    mut bodies: Query<SleepBody, SleepFilter>,
     mut scratch: Local<IslandScratch>,
 ) {
     if !settings.enabled {

@@ -117,6 +117,22 @@ impl PhysicsTime {
         self.accumulator
     }
 
+    /// Follows an outside fixed clock (Bevy's `Time<Fixed>`): the next step is `dt` long and
+    /// starts at `start` (s). An invalid `dt` leaves the step length as it was.
+    #[cfg(feature = "bevy")]
+    pub(crate) fn follow(&mut self, dt: f32, start: f64) {
+        if dt.is_finite() && dt > 0.0 {
+            self.dt = dt;
+        }
+        self.elapsed = start;
+    }
+
+    /// Sets the clock to an outside clock's reading after a step, so the two never drift.
+    #[cfg(feature = "bevy")]
+    pub(crate) fn set_elapsed(&mut self, t: f64) {
+        self.elapsed = t;
+    }
+
     /// Adds frame time and returns how many steps to run and how much time was dropped.
     pub(crate) fn take_frame(&mut self, frame_dt: f32) -> Result<(u32, f32)> {
         if !(frame_dt.is_finite() && frame_dt >= 0.0) {

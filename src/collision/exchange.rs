@@ -41,8 +41,9 @@ pub(super) type SolvedBody<'a> = (
     Option<&'a AngularVelocity>,
 );
 
-/// Bodies the contact systems see: not quarantined.
-pub(super) type Live = Without<Quarantined>;
+/// Bodies the contact systems see: not quarantined, and not a part of another body (its
+/// body carries it in a compound).
+pub(super) type Live = (Without<Quarantined>, Without<super::ColliderOf>);
 
 /// Where each solver body sits in the query's storage order, for one step.
 #[derive(Debug, Default)]

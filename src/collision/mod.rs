@@ -35,6 +35,7 @@
 //!
 //! Units: m, s, kg; impulses in N·s.
 
+mod attach;
 mod broad;
 mod exchange;
 mod fetch;
@@ -44,6 +45,7 @@ mod plugin;
 mod query;
 mod solver;
 
+pub use attach::{ColliderDensity, ColliderOf, ColliderOffset};
 pub(crate) use broad::mark_dirty as mark_broad_phase_dirty;
 pub use narrow::{ContactPair, Contacts};
 pub use plugin::CollisionPlugin;
@@ -72,11 +74,14 @@ use crate::rigid::Rotation;
     ColliderAabb,
     crate::sleep::SleepTimer
 )]
+#[cfg_attr(feature = "bevy", require(bevy_transform::components::Transform))]
 #[component(on_insert = collider_changed, on_remove = collider_changed)]
 pub struct Collider {
     shape: SharedShape,
     /// The shape's local bounding box, kept: the contact systems read it every step.
     bounds: [Vec3; 2],
+    /// Built by hooke from a body's parts (see the `attach` module), not by the user.
+    composed: bool,
 }
 
 impl std::fmt::Debug for Collider {
@@ -90,6 +95,12 @@ fn collider_changed(
     ctx: bevy_ecs::lifecycle::HookContext,
 ) {
     broad::mark_dirty(&mut world, ctx.entity);
+    if world
+        .get::<Collider>(ctx.entity)
+        .is_some_and(|c| !c.composed)
+    {
+        attach::queue_refresh_owner(&mut world, ctx.entity);
+    }
 }
 
 impl Collider {
@@ -104,6 +115,7 @@ impl Collider {
         Ok(Self {
             shape,
             bounds: [aabb.mins, aabb.maxs],
+            composed: false,
         })
     }
 
@@ -225,9 +237,12 @@ impl Collider {
     }
 
     /// Several colliders in one, each at a position and rotation in this shape's frame.
+    /// (Colliders on child entities of a body are the Bevy way to do the same.)
     ///
     /// # Errors
-    /// [`Error::TooFew`] for no parts, [`Error::NonFinite`] for bad poses.
+    /// [`Error::TooFew`] for no parts, [`Error::NonFinite`] for bad poses,
+    /// [`Error::CompositePart`] for a part that is itself a compound, trimesh or heightfield
+    /// (parry cannot nest them).
     pub fn compound(parts: Vec<(Vec3, Quat, Collider)>) -> Result<Self> {
         if parts.is_empty() {
             return Err(Error::TooFew {
@@ -238,6 +253,9 @@ impl Collider {
         }
         let mut shapes = Vec::with_capacity(parts.len());
         for (x, q, c) in parts {
+            if c.shape.as_composite_shape().is_some() {
+                return Err(Error::CompositePart(format!("{:?}", c.shape.shape_type())));
+            }
             let q = Rotation::try_new(q)?.0;
             shapes.push((
                 Pose::from_parts(finite_vec("part position", x)?, q),
@@ -417,6 +435,30 @@ pub struct ContactStarted {
     /// The other.
     pub b: Entity,
 }
+
+/// Triggered on a body with [`CollisionEventsEnabled`] when it starts touching `other`:
+/// observe it with `commands.entity(body).observe(|event: On<ContactStart>| ..)`.
+#[derive(EntityEvent, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ContactStart {
+    /// The body the event is for.
+    pub entity: Entity,
+    /// The one it touches.
+    pub other: Entity,
+}
+
+/// Triggered on a body with [`CollisionEventsEnabled`] when it stops touching `other`.
+#[derive(EntityEvent, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ContactEnd {
+    /// The body the event is for.
+    pub entity: Entity,
+    /// The one it touched.
+    pub other: Entity,
+}
+
+/// Opts a body in to the [`ContactStart`] and [`ContactEnd`] entity events (messages are
+/// written for every pair regardless). Opt-in, so a world that observes nothing pays nothing.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CollisionEventsEnabled;
 
 /// Written when two colliders stop touching (or are despawned while touching).
 #[derive(Message, Debug, Clone, Copy, PartialEq, Eq)]

@@ -14,7 +14,7 @@ use super::{
     Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted,
     Friction, Restitution, Sensor,
 };
-use crate::Plugin;
+use crate::WorldPlugin;
 use crate::integrator::ConstraintsActive;
 use crate::particles::{LinearVelocity, Mass, Position};
 use crate::rigid::{AngularVelocity, CenterOfMass, Inertia, Rotation};
@@ -27,7 +27,7 @@ use crate::time::{PhysicsTime, SubstepTime};
 #[derive(Debug, Default, Clone, Copy)]
 pub struct CollisionPlugin;
 
-impl Plugin for CollisionPlugin {
+impl WorldPlugin for CollisionPlugin {
     fn build(&self, world: &mut World) {
         world.init_resource::<ContactSettings>();
         world.init_resource::<BroadPhase>();
@@ -35,6 +35,16 @@ impl Plugin for CollisionPlugin {
         world.init_resource::<ContactSolver>();
         world.init_resource::<bevy_ecs::message::Messages<ContactStarted>>();
         world.init_resource::<bevy_ecs::message::Messages<ContactEnded>>();
+        world.add_observer(super::attach::on_body_inserted);
+        world.add_observer(super::attach::on_child_of_discarded);
+        world.add_observer(super::attach::on_child_of_inserted);
+        add_systems(
+            world,
+            PhysicsSchedule,
+            super::attach::place_attached_colliders
+                .run_if(any_with_component::<super::ColliderOf>)
+                .in_set(crate::schedule::FinishSystems::Writeback),
+        );
         add_systems(
             world,
             PhysicsSchedule,
@@ -43,6 +53,7 @@ impl Plugin for CollisionPlugin {
                 update_fixed_aabbs.run_if(fixed_dirty),
                 run_broad_phase,
                 update_contacts,
+                trigger_contact_events.run_if(any_with_component::<super::CollisionEventsEnabled>),
                 crate::sleep::wake_hit_islands.run_if(any_with_component::<Sleeping>),
                 prepare_contacts,
             )
@@ -397,6 +408,30 @@ fn update_contacts(
         contacts.pairs.remove(&(a, b));
         if touching {
             ended.write(ContactEnded { a, b });
+        }
+    }
+}
+
+/// Triggers [`super::ContactStart`] / [`super::ContactEnd`] on opted-in bodies, for the
+/// messages written since this system last ran (each message once).
+fn trigger_contact_events(
+    mut commands: Commands,
+    mut started: MessageReader<ContactStarted>,
+    mut ended: MessageReader<ContactEnded>,
+    enabled: Query<(), With<super::CollisionEventsEnabled>>,
+) {
+    for m in started.read() {
+        for (entity, other) in [(m.a, m.b), (m.b, m.a)] {
+            if enabled.contains(entity) {
+                commands.trigger(super::ContactStart { entity, other });
+            }
+        }
+    }
+    for m in ended.read() {
+        for (entity, other) in [(m.a, m.b), (m.b, m.a)] {
+            if enabled.contains(entity) {
+                commands.trigger(super::ContactEnd { entity, other });
+            }
         }
     }
 }

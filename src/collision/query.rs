@@ -89,7 +89,8 @@ type QueryCollider<'a> = (
 /// `World` through `SystemState<SpatialQuery>`.
 #[derive(SystemParam)]
 pub struct SpatialQuery<'w, 's> {
-    colliders: Query<'w, 's, QueryCollider<'static>, Without<Quarantined>>,
+    colliders:
+        Query<'w, 's, QueryCollider<'static>, (Without<Quarantined>, Without<super::ColliderOf>)>,
 }
 
 fn pose(x: &Position, q: &Rotation, com: Option<&CenterOfMass>) -> Pose {

@@ -15,7 +15,7 @@ use crate::rigid::{
 };
 use crate::schedule::{IntegrationSystems, StepSystems, add_force_systems, add_systems};
 use crate::time::SubstepTime;
-use crate::{Plugin, SubstepSchedule};
+use crate::{SubstepSchedule, WorldPlugin};
 
 /// Whether any constraint (contact, joint) acts in this step. Constraint plugins set it in
 /// [`crate::PhysicsSystems::Prepare`]. While it is false nothing runs between the velocity and
@@ -35,7 +35,7 @@ impl ConstraintsActive {
 #[derive(Debug, Default, Clone, Copy)]
 pub struct IntegratorPlugin;
 
-impl Plugin for IntegratorPlugin {
+impl WorldPlugin for IntegratorPlugin {
     fn build(&self, world: &mut World) {
         world.init_resource::<Integrator>();
         world.init_resource::<ConstraintsActive>();

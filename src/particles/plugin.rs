@@ -5,7 +5,7 @@ use glam::Vec3A;
 
 use super::fields::{Advection, Gravity, VelocityField};
 use super::{Force, LinearDamping, LinearVelocity, Mass, Position, Tracer};
-use crate::Plugin;
+use crate::WorldPlugin;
 use crate::integrator::{advect_euler, advect_midpoint, advect_rk4};
 use crate::quarantine::{Quarantined, quarantine_non_finite};
 use crate::schedule::{ForceSystems, StepSystems, SubstepSchedule, add_force_systems, add_systems};
@@ -21,7 +21,7 @@ type Live = (Without<Quarantined>, Without<crate::sleep::Sleeping>);
 #[derive(Debug, Default, Clone, Copy)]
 pub struct GravityPlugin;
 
-impl Plugin for GravityPlugin {
+impl WorldPlugin for GravityPlugin {
     fn build(&self, world: &mut World) {
         world.init_resource::<Gravity>();
     }
@@ -31,7 +31,7 @@ impl Plugin for GravityPlugin {
 #[derive(Debug, Default, Clone, Copy)]
 pub struct DampingPlugin;
 
-impl Plugin for DampingPlugin {
+impl WorldPlugin for DampingPlugin {
     fn build(&self, world: &mut World) {
         add_force_systems(world, || {
             apply_damping
@@ -51,7 +51,7 @@ fn apply_damping(mut bodies: Query<(&mut Force, &LinearVelocity, &Mass, &LinearD
 #[derive(Debug, Default, Clone, Copy)]
 pub struct VelocityFieldPlugin;
 
-impl Plugin for VelocityFieldPlugin {
+impl WorldPlugin for VelocityFieldPlugin {
     fn build(&self, world: &mut World) {
         world.init_resource::<Advection>();
         add_systems(

@@ -6,7 +6,9 @@
 //! shape with no volume (a flat hull, an open mesh, a heightfield) has no mass and is an
 //! error rather than a body that divides by zero.
 
+use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
+use bevy_ecs::world::DeferredWorld;
 use glam::{Mat3, Quat, Vec3};
 use parry3d::shape::Shape;
 
@@ -213,5 +215,108 @@ impl RigidBodyBundle {
     pub fn with_angular_velocity(mut self, omega: Vec3) -> Result<Self> {
         self.angular_velocity = AngularVelocity::from(finite_vec("angular velocity", omega)?);
         Ok(self)
+    }
+}
+
+/// Mass properties hooke computed for a body (from its colliders, or the default for a
+/// body with none); a [`Mass`] of a different value is the user's and is left alone.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+pub(crate) struct ComputedMass {
+    pub(crate) mass: f32,
+}
+
+/// A dynamic body's mass properties when nothing gives any: 1 kg with the inertia of a
+/// uniform 1 m cube (m/6 about each axis), centre of mass at the frame origin.
+#[must_use]
+pub fn default_mass() -> MassProperties {
+    MassProperties {
+        mass: 1.0,
+        center_of_mass: Vec3::ZERO,
+        inertia: Inertia::diagonal(1.0 / 6.0, 1.0 / 6.0, 1.0 / 6.0).unwrap_or(Inertia::INFINITE),
+    }
+}
+
+/// Inserts computed mass properties on `body`, keeping its frame origin where it was: the
+/// centre of mass x moves by R (c_new − c_old).
+pub(crate) fn insert_computed_mass(world: &mut World, body: Entity, props: MassProperties) {
+    let Ok(mut e) = world.get_entity_mut(body) else {
+        return;
+    };
+    let Ok(mass) = Mass::new(props.mass) else {
+        return;
+    };
+    let old_c = e.get::<CenterOfMass>().map_or(Vec3::ZERO, |c| c.0);
+    let q = e.get::<Rotation>().map_or(glam::Quat::IDENTITY, |r| r.0);
+    let shift = q * (props.center_of_mass - old_c);
+    if shift != Vec3::ZERO
+        && let Some(mut x) = e.get_mut::<Position>()
+    {
+        x.0 += glam::Vec3A::from(shift);
+    }
+    e.insert((
+        mass,
+        props.inertia,
+        CenterOfMass(props.center_of_mass),
+        ComputedMass { mass: props.mass },
+    ));
+}
+
+/// Insert hook of [`RigidBody`]: the kind decides the mass components. A dynamic body
+/// with no [`Mass`] gets [`default_mass`] until its colliders give a better one; a kinematic
+/// body gets infinite mass and inertia; a static body loses every mass and velocity
+/// component, so no system visits it.
+pub(crate) fn body_kind_changed(mut world: DeferredWorld, ctx: HookContext) {
+    let body = ctx.entity;
+    world
+        .commands()
+        .queue(move |world: &mut World| apply_body_kind(world, body));
+}
+
+fn apply_body_kind(world: &mut World, body: Entity) {
+    let Ok(mut e) = world.get_entity_mut(body) else {
+        return;
+    };
+    let Some(kind) = e.get::<RigidBody>().copied() else {
+        return;
+    };
+    let computed = e.get::<ComputedMass>().copied();
+    let mass = e.get::<Mass>().copied();
+    match kind {
+        RigidBody::Dynamic => {
+            let stale = match (mass, computed) {
+                (None, _) => true,
+                // Was kinematic by hooke's doing: dynamic again.
+                (Some(m), Some(_)) => m.is_pinned(),
+                (Some(_), None) => false,
+            };
+            if stale {
+                insert_computed_mass(world, body, default_mass());
+            }
+        }
+        RigidBody::Kinematic => {
+            if mass.is_none_or(|m| !m.is_pinned()) {
+                e.insert((
+                    Mass::PINNED,
+                    Inertia::INFINITE,
+                    ComputedMass {
+                        mass: f32::INFINITY,
+                    },
+                ));
+            }
+        }
+        RigidBody::Static => {
+            if mass.is_some() || e.contains::<LinearVelocity>() {
+                e.remove::<(
+                    Mass,
+                    Inertia,
+                    LinearVelocity,
+                    AngularVelocity,
+                    crate::rigid::AngularMomentum,
+                    crate::particles::Force,
+                    crate::rigid::Torque,
+                    ComputedMass,
+                )>();
+            }
+        }
     }
 }

@@ -42,7 +42,8 @@
 mod mass;
 mod plugin;
 
-pub use mass::{MassProperties, RigidBodyBundle, parallel_axis};
+pub(crate) use mass::{ComputedMass, insert_computed_mass};
+pub use mass::{MassProperties, RigidBodyBundle, default_mass, parallel_axis};
 pub use plugin::RigidBodyPlugin;
 
 use bevy_ecs::prelude::*;
@@ -52,9 +53,19 @@ use crate::error::{Error, Result, finite, finite_vec, non_negative};
 use crate::particles::Position;
 use crate::quarantine::{Validate, validate_on_insert};
 
-/// How a rigid body moves. Spawn bodies with [`RigidBodyBundle`].
+/// How a rigid body moves.
+///
+/// Spawn a body the way Bevy spawns anything, with required components:
+/// `(RigidBody::Dynamic, Collider::cuboid(0.5, 0.5, 0.5)?, Position(..))` is a dynamic body
+/// whose mass, centre of mass and inertia come from its colliders and their
+/// [`crate::ColliderDensity`] (1000 kg/m³ by default), unless you give a [`crate::Mass`] (or
+/// use [`RigidBodyBundle`]). Inserting another kind later changes the body: kinematic
+/// bodies get infinite mass and inertia, static bodies lose their mass and velocity
+/// components.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[require(Position, Rotation)]
+#[cfg_attr(feature = "bevy", require(bevy_transform::components::Transform))]
+#[component(on_insert = mass::body_kind_changed)]
 pub enum RigidBody {
     /// Moved by forces and torques.
     #[default]

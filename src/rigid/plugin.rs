@@ -8,7 +8,7 @@ use super::{
     KinematicTarget, OrientationUpdate, Renormalization, Rotation, SkipRenormalization, Torque,
     free_rotation_split, integrate_rotation, omega_of, world_point,
 };
-use crate::Plugin;
+use crate::WorldPlugin;
 use crate::integrator::{Integrator, IntegratorOverride};
 use crate::particles::{Force, LinearVelocity, Position};
 use crate::quarantine::{Quarantined, quarantine_non_finite};
@@ -27,7 +27,7 @@ type Live = (Without<Quarantined>, Without<crate::sleep::Sleeping>);
 #[derive(Debug, Default, Clone, Copy)]
 pub struct RigidBodyPlugin;
 
-impl Plugin for RigidBodyPlugin {
+impl WorldPlugin for RigidBodyPlugin {
     fn build(&self, world: &mut World) {
         world.init_resource::<OrientationUpdate>();
         world.init_resource::<Renormalization>();

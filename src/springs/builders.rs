@@ -112,6 +112,19 @@ impl ChainBuilder {
     /// [`Error::TooFew`] for fewer than 2 nodes, and the errors of the particle and spring
     /// constructors for bad values. Nothing is spawned on error.
     pub fn spawn(&self, world: &mut World) -> Result<Chain> {
+        self.spawn_into(world)
+    }
+
+    /// As [`ChainBuilder::spawn`], from a system's `Commands` (the entities exist once the
+    /// commands are applied; their ids are known at once).
+    ///
+    /// # Errors
+    /// As [`ChainBuilder::spawn`]; nothing is spawned on an error.
+    pub fn spawn_with(&self, commands: &mut Commands) -> Result<Chain> {
+        self.spawn_into(commands)
+    }
+
+    fn spawn_into(&self, world: &mut impl Spawn) -> Result<Chain> {
         if self.nodes < 2 {
             return Err(Error::TooFew {
                 what: "chain nodes",
@@ -134,7 +147,7 @@ impl ChainBuilder {
                 ParticleBundle::new(x, Vec3::ZERO, self.node_mass)?
             });
         }
-        let nodes: Vec<Entity> = bundles.into_iter().map(|b| world.spawn(b).id()).collect();
+        let nodes: Vec<Entity> = bundles.into_iter().map(|b| world.spawn_one(b)).collect();
         let seg = step.length();
         let mut chain = Chain {
             nodes,
@@ -142,12 +155,12 @@ impl ChainBuilder {
         };
         for w in chain.nodes.windows(2) {
             let s = Spring::from_hooke(w[0], w[1], seg, k, c)?;
-            chain.springs.push(world.spawn(s).id());
+            chain.springs.push(world.spawn_one(s));
         }
         if kb > 0.0 {
             for w in chain.nodes.windows(3) {
                 let s = Spring::from_hooke(w[0], w[2], 2.0 * seg, kb, 0.0)?;
-                chain.bend_springs.push(world.spawn(s).id());
+                chain.bend_springs.push(world.spawn_one(s));
             }
         }
         Ok(chain)
@@ -267,5 +280,31 @@ impl ClothBuilder {
     pub fn spawn(&self, world: &mut World) -> Result<Entity> {
         let (nodes, net) = self.build()?;
         Ok(world.spawn((nodes, net)).id())
+    }
+
+    /// As [`ClothBuilder::spawn`], from a system's `Commands`.
+    ///
+    /// # Errors
+    /// As [`ClothBuilder::build`].
+    pub fn spawn_with(&self, commands: &mut Commands) -> Result<Entity> {
+        let (nodes, net) = self.build()?;
+        Ok(commands.spawn((nodes, net)).id())
+    }
+}
+
+/// Where a builder spawns: a `World` directly, or a system's `Commands`.
+trait Spawn {
+    fn spawn_one<B: Bundle>(&mut self, bundle: B) -> Entity;
+}
+
+impl Spawn for World {
+    fn spawn_one<B: Bundle>(&mut self, bundle: B) -> Entity {
+        self.spawn(bundle).id()
+    }
+}
+
+impl Spawn for Commands<'_, '_> {
+    fn spawn_one<B: Bundle>(&mut self, bundle: B) -> Entity {
+        self.spawn(bundle).id()
     }
 }

@@ -13,7 +13,7 @@ use crate::rigid::{AngularVelocity, Rotation, Torque};
 use crate::schedule::{
     ForceSystems, PhysicsSchedule, PrepareSystems, add_force_systems, add_systems,
 };
-use crate::{Error, Plugin};
+use crate::{Error, WorldPlugin};
 
 type Live = Without<Quarantined>;
 
@@ -22,7 +22,7 @@ type Live = Without<Quarantined>;
 #[derive(Debug, Default, Clone, Copy)]
 pub struct SpringPlugin;
 
-impl Plugin for SpringPlugin {
+impl WorldPlugin for SpringPlugin {
     fn build(&self, world: &mut World) {
         add_force_systems(world, || {
             (

@@ -1,0 +1,207 @@
+//! `Transform` ⇄ physics pose.
+//!
+//! hooke's state is the centre of mass x ([`Position`]) and the orientation q
+//! ([`Rotation`]); a `Transform` places the entity's frame origin, which is x − R c for a
+//! body with centre of mass c ([`CenterOfMass`], shape frame). Every body and collider
+//! remembers the `Transform` hooke last wrote or read ([`SyncedTransform`]); a `Transform`
+//! that differs was written by someone else, and becomes the physics pose before the next
+//! step. That comparison of values, not of change ticks, is what makes a write through
+//! `get_mut`, a `commands.insert` and an interpolated frame all behave the same.
+//!
+//! On first sight a body's `Transform` wins, unless it is the identity while the physics
+//! pose is not (a body spawned with `Position`): then the physics pose wins. Scale is left
+//! alone and does not scale colliders.
+
+use bevy_app::{App, Plugin};
+use bevy_ecs::hierarchy::ChildOf;
+use bevy_ecs::prelude::*;
+use bevy_transform::components::{GlobalTransform, Transform};
+use glam::{Quat, Vec3, Vec3A};
+
+use super::interpolation::PoseHistory;
+use super::{AppSchedule, PhysicsAppSystems};
+use crate::collision::{Collider, ColliderOf, ColliderOffset};
+use crate::particles::{LinearVelocity, Position};
+use crate::quarantine::Quarantined;
+use crate::rigid::{CenterOfMass, RigidBody, Rotation};
+
+/// Reads written `Transform`s before each step and writes poses back after it.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct PhysicsTransformPlugin;
+
+impl Plugin for PhysicsTransformPlugin {
+    fn build(&self, app: &mut App) {
+        let schedule = app
+            .world()
+            .get_resource::<AppSchedule>()
+            .map_or_else(|| super::PhysicsSchedulePlugin::default().schedule, |s| s.0);
+        app.add_systems(
+            schedule,
+            (
+                (read_transforms, read_child_offsets).in_set(PhysicsAppSystems::ReadTransforms),
+                write_transforms.in_set(PhysicsAppSystems::Writeback),
+            ),
+        );
+    }
+}
+
+/// The `Transform` hooke last wrote or read for this entity. Added by hooke.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+pub struct SyncedTransform {
+    translation: Vec3,
+    rotation: Quat,
+}
+
+impl SyncedTransform {
+    pub(super) fn of(t: &Transform) -> Self {
+        Self {
+            translation: t.translation,
+            rotation: t.rotation,
+        }
+    }
+
+    fn matches(&self, t: &Transform) -> bool {
+        self.translation == t.translation && self.rotation == t.rotation
+    }
+}
+
+/// A parent's world pose as (translation, rotation), ignoring scale.
+fn parent_pose(parent: Option<&ChildOf>, globals: &Query<&GlobalTransform>) -> (Vec3, Quat) {
+    parent
+        .and_then(|p| globals.get(p.parent()).ok())
+        .map_or((Vec3::ZERO, Quat::IDENTITY), |g| {
+            let (_, r, t) = g.to_scale_rotation_translation();
+            (t, r)
+        })
+}
+
+type BodyPose<'a> = (
+    Entity,
+    &'a mut Transform,
+    Option<&'a ChildOf>,
+    Option<&'a SyncedTransform>,
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    Option<&'a mut PoseHistory>,
+);
+type Posed = (
+    Or<(With<RigidBody>, With<Collider>)>,
+    Without<ColliderOf>,
+    Without<Quarantined>,
+);
+
+/// Written `Transform`s become [`Position`] and [`Rotation`] (inserted, so the broad phase,
+/// the validating hooks and the sleep rules all hear of it).
+fn read_transforms(
+    mut commands: Commands,
+    mut bodies: Query<BodyPose, Posed>,
+    globals: Query<&GlobalTransform>,
+) {
+    for (e, mut t, parent, synced, x, q, com, history) in &mut bodies {
+        if synced.is_some_and(|s| s.matches(&t)) {
+            continue;
+        }
+        let c = com.map_or(Vec3::ZERO, |c| c.0);
+        let (pt, pr) = parent_pose(parent, &globals);
+        if synced.is_none()
+            && *t == Transform::IDENTITY
+            && (x.0 != Vec3A::ZERO || q.0 != Quat::IDENTITY)
+        {
+            // Spawned through the physics API: the physics pose wins.
+            let origin = Vec3::from(x.0) - q.0 * c;
+            t.translation = pr.inverse() * (origin - pt);
+            t.rotation = pr.inverse() * q.0;
+            commands.entity(e).insert(SyncedTransform::of(&t));
+            continue;
+        }
+        let rotation = (pr * t.rotation).normalize();
+        let origin = pt + pr * t.translation;
+        let centre = origin + rotation * c;
+        if let Some(mut h) = history {
+            h.reset(t.translation, t.rotation);
+        }
+        commands.entity(e).insert((
+            Position(centre.into()),
+            Rotation(rotation),
+            SyncedTransform::of(&t),
+        ));
+    }
+}
+
+type ChildPose<'a> = (
+    Entity,
+    &'a Transform,
+    Option<&'a SyncedTransform>,
+    Option<&'a ColliderOffset>,
+);
+
+/// A child collider's written `Transform` becomes its [`ColliderOffset`] in the body.
+fn read_child_offsets(
+    mut commands: Commands,
+    children: Query<ChildPose, (With<ColliderOf>, Without<Quarantined>)>,
+) {
+    for (e, t, synced, offset) in &children {
+        if synced.is_some_and(|s| s.matches(t)) {
+            continue;
+        }
+        let new = ColliderOffset {
+            translation: t.translation,
+            rotation: t.rotation,
+        };
+        let mut cmd = commands.entity(e);
+        if offset != Some(&new) {
+            cmd.insert(new);
+        }
+        cmd.insert(SyncedTransform::of(t));
+    }
+}
+
+type Written<'a> = (
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    Option<&'a ChildOf>,
+    &'a mut Transform,
+    Option<&'a mut SyncedTransform>,
+    Option<&'a mut PoseHistory>,
+);
+
+/// Bodies whose pose the step moves.
+type Moving = (
+    With<LinearVelocity>,
+    Without<ColliderOf>,
+    Without<Quarantined>,
+);
+
+/// Moving bodies' poses become their `Transform`s (frame origin x − R c, in the parent's
+/// frame), written only where they changed so that change detection stays meaningful.
+fn write_transforms(
+    mut commands: Commands,
+    mut bodies: Query<(Entity, Written), Moving>,
+    globals: Query<&GlobalTransform>,
+) {
+    for (e, (x, q, com, parent, mut t, synced, history)) in &mut bodies {
+        let c = com.map_or(Vec3::ZERO, |c| c.0);
+        let origin = Vec3::from(x.0) - q.0 * c;
+        let (pt, pr) = parent_pose(parent, &globals);
+        let (translation, rotation) = if parent.is_some() {
+            (pr.inverse() * (origin - pt), pr.inverse() * q.0)
+        } else {
+            (origin, q.0)
+        };
+        if t.translation != translation || t.rotation != rotation {
+            t.translation = translation;
+            t.rotation = rotation;
+        }
+        if let Some(mut h) = history {
+            h.push(translation, rotation);
+        }
+        match synced {
+            Some(mut s) => *s = SyncedTransform::of(&t),
+            None => {
+                commands.entity(e).insert(SyncedTransform::of(&t));
+            }
+        }
+    }
+}
