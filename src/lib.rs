@@ -1,7 +1,9 @@
 //! # hooke
 //!
 //! Physics for entity-component-system games, on `bevy_ecs`: particles, tracers in velocity
-//! fields, mass–spring ropes, hair and cloth, with an integrator dial and NaN quarantine.
+//! fields, mass–spring ropes, hair and cloth, rigid bodies with parry collisions, with an
+//! integrator dial and NaN quarantine. Works on a bare `World` and, with the `bevy` feature,
+//! in a Bevy `App`.
 //!
 //! A bare `World` is a complete simulation; no app framework is needed:
 //!
@@ -33,6 +35,94 @@
 //! | [`DampingPlugin`] | f = −c m v | [`LinearDamping`] |
 //! | [`VelocityFieldPlugin`] | dx/dt = Σ u(x, t) | [`Tracer`], [`VelocityField`] |
 //! | [`SpringPlugin`] | damped springs | [`Spring`], [`SpringNetwork`] |
+//! | [`RigidBodyPlugin`] | orientation, angular momentum, torque, renormalisation | [`Inertia`] ([`RigidBody`]) |
+//! | [`CollisionPlugin`] | broad and narrow phase, contact solver, contact messages, [`SpatialQuery`], mass from colliders, child colliders | [`Collider`] |
+//! | [`SleepPlugin`] | resting islands stop costing anything | [`Collider`] bodies |
+//!
+//! With the `bevy` feature, [`PhysicsPlugins`] is also a Bevy `PluginGroup`, every plugin above
+//! a Bevy `Plugin`, and [`bevy`] adds the App clock, `Transform` sync, interpolation and
+//! diagnostics plugins.
+//!
+//! | feature | default | what |
+//! |---|---|---|
+//! | `bevy` | off | `bevy_app`, `bevy_time`, `bevy_transform`, `bevy_diagnostic` 0.20: see [`bevy`] |
+//!
+//! ## Spawning
+//!
+//! Required components do the rest: a dynamic body needs a kind and a shape.
+//!
+//! ```
+//! use bevy_ecs::prelude::*;
+//! use hooke::prelude::*;
+//!
+//! let mut world = World::new();
+//! world.add_physics(PhysicsPlugins);
+//! world.spawn((
+//!     RigidBody::Static,
+//!     Collider::cuboid(10.0, 0.5, 10.0).unwrap(), // half extents (m)
+//!     Position::from(Vec3::new(0.0, -0.5, 0.0)),
+//! ));
+//! let crate_ = world
+//!     .spawn((
+//!         RigidBody::Dynamic,
+//!         Collider::cuboid(0.5, 0.5, 0.5).unwrap(),
+//!         Position::from(Vec3::new(0.0, 3.0, 0.0)),
+//!     ))
+//!     .id();
+//! // Mass from the shape at the default 1000 kg/m³.
+//! let kg = world.get::<Mass>(crate_).unwrap().value();
+//! assert!((kg - 1000.0).abs() < 0.01, "{kg}");
+//! for _ in 0..120 {
+//!     world.step_physics();
+//! }
+//! let y = world.get::<Position>(crate_).unwrap().get().y;
+//! assert!((y - 0.5).abs() < 0.02, "resting on the ground: {y}");
+//! ```
+//!
+//! A collider on a child entity is a part of its parent body:
+//!
+//! ```
+//! use bevy_ecs::prelude::*;
+//! use hooke::prelude::*;
+//!
+//! let mut world = World::new();
+//! world.add_physics(PhysicsPlugins);
+//! let body = world.spawn(RigidBody::Dynamic).id();
+//! for x in [-1.0, 1.0] {
+//!     world.spawn((
+//!         Collider::ball(0.5).unwrap(),
+//!         ColliderOffset::try_new(Vec3::new(x, 0.0, 0.0), Quat::IDENTITY).unwrap(),
+//!         ChildOf(body),
+//!     ));
+//! }
+//! let mass = world.get::<Mass>(body).unwrap().value();
+//! assert!((mass - 2.0 * 1000.0 * 4.0 / 3.0 * std::f32::consts::PI * 0.125).abs() < 1.0);
+//! ```
+//!
+//! Ropes, hair and cloth come from builders, on a `World` or from `Commands`:
+//!
+//! ```
+//! use bevy_ecs::prelude::*;
+//! use hooke::prelude::*;
+//!
+//! let mut world = World::new();
+//! world.add_physics(PhysicsPlugins);
+//! let rope = ChainBuilder::rope(Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), 11)
+//!     .stiffness(500.0)
+//!     .spawn(&mut world)
+//!     .unwrap();
+//! world.step_physics();
+//! let end = world.get::<Position>(*rope.nodes.last().unwrap()).unwrap().get();
+//! assert!(end.y < 0.0); // the free end falls; the first node is pinned
+//! ```
+//!
+//! Bad values are typed errors, never panics:
+//!
+//! ```
+//! use hooke::prelude::*;
+//! assert!(matches!(Collider::ball(-1.0), Err(Error::NotPositive { .. })));
+//! assert!(matches!(Mass::new(f32::NAN), Err(Error::InvalidMass(_))));
+//! ```
 //!
 //! ## Order
 //!
@@ -60,6 +150,9 @@ pub mod schedule;
 pub mod sleep;
 pub mod springs;
 pub mod time;
+
+/// parry, re-exported so custom shapes ([`Collider::new`]) need no second dependency.
+pub use parry3d;
 
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
@@ -93,6 +186,11 @@ pub use time::{FrameReport, PhysicsTime, SubstepTime};
 
 /// Everything a game needs in scope.
 pub mod prelude {
+    #[cfg(feature = "bevy")]
+    pub use crate::bevy::{
+        PhysicsAppSystems, PhysicsDiagnosticsPlugin, PhysicsSchedulePlugin, TransformExtrapolation,
+        TransformInterpolation,
+    };
     pub use crate::{
         Advection, BodyQuarantined, ChainBuilder, ClothBuilder, DiagnosticsSettings, Error,
         ExternalForce, ExternalImpulse, Force, Gravity, GravityScale, Integrator,
@@ -101,9 +199,12 @@ pub mod prelude {
         QuarantineReason, Quarantined, Spring, SpringNetwork, Tracer, VelocityField, WorldPlugin,
     };
     pub use crate::{
-        AngularVelocity, Collider, CollisionLayers, Contacts, Friction, Inertia, MassProperties,
-        Restitution, RigidBody, RigidBodyBundle, Rotation, Sensor, Sleeping, SpatialQuery,
+        AngularVelocity, CenterOfMass, Collider, ColliderDensity, ColliderOf, ColliderOffset,
+        CollisionEventsEnabled, ContactEnd, ContactStart, Contacts, Friction, Inertia,
+        MassProperties, Restitution, RigidBody, RigidBodyBundle, Rotation, Sensor, Sleeping,
+        SpatialQuery,
     };
+    pub use crate::{CollisionLayers, ContactEnded, ContactStarted};
     pub use glam::{Quat, Vec3, Vec3A};
 }
 

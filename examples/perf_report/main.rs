@@ -7,8 +7,11 @@
 //! ```text
 //! cargo run --release --example perf_report -- --quick
 //! cargo run --release --example perf_report -- --only contacts
+//! cargo run --release --features bevy --example perf_report -- --only bevy
 //! ```
 
+#[cfg(feature = "bevy")]
+mod bevy_layer;
 mod contacts;
 mod rigid;
 #[path = "../common/timing.rs"]
@@ -376,7 +379,7 @@ fn main() {
         "{:<48} {:>14} {:>14} {:>7}  note",
         "name", "ours_ns", "reference_ns", "ratio"
     );
-    // `--only particles|rigid|contacts|dial` runs one group.
+    // `--only particles|rigid|contacts|bevy|dial` runs one group (bevy with `--features bevy`).
     let only = std::env::args()
         .skip_while(|a| a != "--only")
         .nth(1)
@@ -395,6 +398,10 @@ fn main() {
     }
     if run("contacts") {
         contacts::contact_scenes(&cfg, quick);
+    }
+    #[cfg(feature = "bevy")]
+    if run("bevy") {
+        bevy_layer::bevy_layer(&cfg);
     }
     if run("dial") {
         accuracy_dial(&cfg);

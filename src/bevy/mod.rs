@@ -51,9 +51,9 @@ mod transform;
 
 pub use diagnostics::PhysicsDiagnosticsPlugin;
 pub use interpolation::{
-    PhysicsInterpolationPlugin, TransformExtrapolation, TransformInterpolation,
+    PhysicsInterpolationPlugin, PoseHistory, TransformExtrapolation, TransformInterpolation,
 };
-pub use transform::PhysicsTransformPlugin;
+pub use transform::{PhysicsTransformPlugin, SyncedTransform};
 
 use bevy_app::{App, FixedPostUpdate, Plugin, PluginGroup, PluginGroupBuilder};
 use bevy_ecs::intern::Interned;

@@ -21,7 +21,7 @@ use glam::{Quat, Vec3, Vec3A};
 use super::interpolation::PoseHistory;
 use super::{AppSchedule, PhysicsAppSystems};
 use crate::collision::{Collider, ColliderOf, ColliderOffset};
-use crate::particles::{LinearVelocity, Position};
+use crate::particles::{LinearVelocity, Mass, Position};
 use crate::quarantine::Quarantined;
 use crate::rigid::{CenterOfMass, RigidBody, Rotation};
 
@@ -65,6 +65,11 @@ impl SyncedTransform {
     }
 }
 
+/// A parent's world rotation.
+fn pr_of(parent: Option<&ChildOf>, globals: &Query<&GlobalTransform>) -> Quat {
+    parent_pose(parent, globals).1
+}
+
 /// A parent's world pose as (translation, rotation), ignoring scale.
 fn parent_pose(parent: Option<&ChildOf>, globals: &Query<&GlobalTransform>) -> (Vec3, Quat) {
     parent
@@ -81,12 +86,12 @@ type BodyPose<'a> = (
     Option<&'a ChildOf>,
     Option<&'a SyncedTransform>,
     &'a Position,
-    &'a Rotation,
+    Option<&'a Rotation>,
     Option<&'a CenterOfMass>,
     Option<&'a mut PoseHistory>,
 );
 type Posed = (
-    Or<(With<RigidBody>, With<Collider>)>,
+    Or<(With<RigidBody>, With<Collider>, With<Mass>)>,
     Without<ColliderOf>,
     Without<Quarantined>,
 );
@@ -102,6 +107,11 @@ fn read_transforms(
         if synced.is_some_and(|s| s.matches(&t)) {
             continue;
         }
+        // A particle has no orientation of its own: its Transform keeps the one it has.
+        let particle = q.is_none();
+        let q = q
+            .copied()
+            .unwrap_or_else(|| Rotation(pr_of(parent, &globals) * t.rotation));
         let c = com.map_or(Vec3::ZERO, |c| c.0);
         let (pt, pr) = parent_pose(parent, &globals);
         if synced.is_none()
@@ -121,11 +131,11 @@ fn read_transforms(
         if let Some(mut h) = history {
             h.reset(t.translation, t.rotation);
         }
-        commands.entity(e).insert((
-            Position(centre.into()),
-            Rotation(rotation),
-            SyncedTransform::of(&t),
-        ));
+        let mut cmd = commands.entity(e);
+        cmd.insert((Position(centre.into()), SyncedTransform::of(&t)));
+        if !particle {
+            cmd.insert(Rotation(rotation));
+        }
     }
 }
 
@@ -159,7 +169,7 @@ fn read_child_offsets(
 
 type Written<'a> = (
     &'a Position,
-    &'a Rotation,
+    Option<&'a Rotation>,
     Option<&'a CenterOfMass>,
     Option<&'a ChildOf>,
     &'a mut Transform,
@@ -182,9 +192,10 @@ fn write_transforms(
     globals: Query<&GlobalTransform>,
 ) {
     for (e, (x, q, com, parent, mut t, synced, history)) in &mut bodies {
+        let (pt, pr) = parent_pose(parent, &globals);
+        let q = q.copied().unwrap_or_else(|| Rotation(pr * t.rotation));
         let c = com.map_or(Vec3::ZERO, |c| c.0);
         let origin = Vec3::from(x.0) - q.0 * c;
-        let (pt, pr) = parent_pose(parent, &globals);
         let (translation, rotation) = if parent.is_some() {
             (pr.inverse() * (origin - pt), pr.inverse() * q.0)
         } else {
@@ -198,7 +209,11 @@ fn write_transforms(
             h.push(translation, rotation);
         }
         match synced {
-            Some(mut s) => *s = SyncedTransform::of(&t),
+            Some(mut s) => {
+                if !s.matches(&t) {
+                    *s = SyncedTransform::of(&t);
+                }
+            }
             None => {
                 commands.entity(e).insert(SyncedTransform::of(&t));
             }

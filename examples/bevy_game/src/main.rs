@@ -1,0 +1,199 @@
+//! A stack to knock over and a ball to throw: hooke in a windowed Bevy game.
+//!
+//! - **Left click**: throw a steel ball from the camera towards the cursor.
+//! - **Space**: throw one straight at the stack.
+//! - **R**: rebuild the stack.
+//! - **Arrow keys**: orbit the camera.
+//!
+//! ```sh
+//! cargo run --release --manifest-path examples/bevy_game/Cargo.toml
+//! ```
+
+use bevy::prelude::*;
+use hooke::prelude::{
+    Collider, ColliderDensity, LinearVelocity, PhysicsPlugins, RigidBody, TransformInterpolation,
+};
+
+/// Half extent of a crate (m).
+const HALF: f32 = 0.25;
+
+#[derive(Component)]
+struct Crate;
+
+#[derive(Component)]
+struct Thrown;
+
+#[derive(Resource)]
+struct Look {
+    yaw: f32,
+    pitch: f32,
+    distance: f32,
+}
+
+#[derive(Resource)]
+struct Assets3d {
+    crate_mesh: Handle<Mesh>,
+    crate_material: Handle<StandardMaterial>,
+    ball_mesh: Handle<Mesh>,
+    ball_material: Handle<StandardMaterial>,
+}
+
+fn main() {
+    App::new()
+        .add_plugins(DefaultPlugins.set(WindowPlugin {
+            primary_window: Some(Window {
+                title: "hooke: knock the stack over".into(),
+                ..default()
+            }),
+            ..default()
+        }))
+        .add_plugins(PhysicsPlugins)
+        .insert_resource(Time::<Fixed>::from_hz(60.0))
+        .insert_resource(Look {
+            yaw: 0.0,
+            pitch: 0.35,
+            distance: 12.0,
+        })
+        .add_systems(Startup, setup)
+        .add_systems(Update, (orbit_camera, throw, rebuild))
+        .run();
+}
+
+fn setup(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) -> Result {
+    let assets = Assets3d {
+        crate_mesh: meshes.add(Cuboid::new(2.0 * HALF, 2.0 * HALF, 2.0 * HALF)),
+        crate_material: materials.add(Color::srgb(0.8, 0.55, 0.3)),
+        ball_mesh: meshes.add(Sphere::new(0.2)),
+        ball_material: materials.add(Color::srgb(0.6, 0.6, 0.65)),
+    };
+    commands.spawn((
+        RigidBody::Static,
+        Collider::cuboid(15.0, 0.5, 15.0)?, // half extents: a 30 m × 1 m × 30 m floor
+        Mesh3d(meshes.add(Cuboid::new(30.0, 1.0, 30.0))),
+        MeshMaterial3d(materials.add(Color::srgb(0.3, 0.5, 0.3))),
+        Transform::from_xyz(0.0, -0.5, 0.0),
+    ));
+    spawn_stack(&mut commands, &assets)?;
+    commands.insert_resource(assets);
+    commands.spawn((
+        DirectionalLight {
+            illuminance: 10_000.0,
+            shadow_maps_enabled: true,
+            ..default()
+        },
+        Transform::from_xyz(4.0, 10.0, 6.0).looking_at(Vec3::ZERO, Vec3::Y),
+    ));
+    commands.spawn((Camera3d::default(), Transform::default()));
+    commands.spawn((
+        Text::new("left click: throw at the cursor · space: throw · R: rebuild · arrows: orbit"),
+        Node {
+            position_type: PositionType::Absolute,
+            top: px(8),
+            left: px(8),
+            ..default()
+        },
+    ));
+    Ok(())
+}
+
+/// A 4 × 4 wall of crates, 6 high.
+fn spawn_stack(commands: &mut Commands, assets: &Assets3d) -> Result {
+    for row in 0..6 {
+        for col in 0..4 {
+            let x = (col as f32 - 1.5) * 2.0 * HALF + if row % 2 == 1 { 0.1 } else { 0.0 };
+            commands.spawn((
+                Crate,
+                RigidBody::Dynamic,
+                Collider::cuboid(HALF, HALF, HALF)?,
+                ColliderDensity::try_new(300.0)?, // wood
+                Mesh3d(assets.crate_mesh.clone()),
+                MeshMaterial3d(assets.crate_material.clone()),
+                Transform::from_xyz(x, HALF + row as f32 * 2.0 * HALF, 0.0),
+                TransformInterpolation,
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn orbit_camera(
+    keys: Res<ButtonInput<KeyCode>>,
+    time: Res<Time>,
+    mut look: ResMut<Look>,
+    mut camera: Single<&mut Transform, With<Camera3d>>,
+) {
+    let rate = 1.5 * time.delta_secs();
+    if keys.pressed(KeyCode::ArrowLeft) {
+        look.yaw -= rate;
+    }
+    if keys.pressed(KeyCode::ArrowRight) {
+        look.yaw += rate;
+    }
+    if keys.pressed(KeyCode::ArrowUp) {
+        look.pitch = (look.pitch + rate).min(1.4);
+    }
+    if keys.pressed(KeyCode::ArrowDown) {
+        look.pitch = (look.pitch - rate).max(0.05);
+    }
+    let target = Vec3::new(0.0, 1.2, 0.0);
+    let eye = target
+        + look.distance
+            * Vec3::new(
+                look.yaw.sin() * look.pitch.cos(),
+                look.pitch.sin(),
+                look.yaw.cos() * look.pitch.cos(),
+            );
+    **camera = Transform::from_translation(eye).looking_at(target, Vec3::Y);
+}
+
+fn throw(
+    mut commands: Commands,
+    mouse: Res<ButtonInput<MouseButton>>,
+    keys: Res<ButtonInput<KeyCode>>,
+    window: Single<&Window>,
+    camera: Single<(&Camera, &GlobalTransform)>,
+    assets: Res<Assets3d>,
+) -> Result {
+    let (camera, eye) = *camera;
+    let direction = if mouse.just_pressed(MouseButton::Left) {
+        let Some(cursor) = window.cursor_position() else {
+            return Ok(());
+        };
+        camera.viewport_to_world(eye, cursor)?.direction.as_vec3()
+    } else if keys.just_pressed(KeyCode::Space) {
+        (Vec3::new(0.0, 1.0, 0.0) - eye.translation()).normalize()
+    } else {
+        return Ok(());
+    };
+    commands.spawn((
+        Thrown,
+        RigidBody::Dynamic,
+        Collider::ball(0.2)?,
+        ColliderDensity::try_new(7800.0)?, // steel: 261 kg
+        LinearVelocity::from(direction * 25.0),
+        Mesh3d(assets.ball_mesh.clone()),
+        MeshMaterial3d(assets.ball_material.clone()),
+        Transform::from_translation(eye.translation() + direction),
+        TransformInterpolation,
+    ));
+    Ok(())
+}
+
+fn rebuild(
+    mut commands: Commands,
+    keys: Res<ButtonInput<KeyCode>>,
+    old: Query<Entity, Or<(With<Crate>, With<Thrown>)>>,
+    assets: Res<Assets3d>,
+) -> Result {
+    if keys.just_pressed(KeyCode::KeyR) {
+        for e in &old {
+            commands.entity(e).despawn();
+        }
+        spawn_stack(&mut commands, &assets)?;
+    }
+    Ok(())
+}
