@@ -120,6 +120,7 @@ struct SetClock {
 
 pub(crate) fn install(world: &mut World) {
     world.init_resource::<PhysicsDiagnostics>();
+    world.add_observer(count_quarantine);
     world.init_resource::<DiagnosticsSettings>();
     world.init_resource::<SetClock>();
     for k in 0..=9u8 {
@@ -155,6 +156,19 @@ pub(crate) fn install(world: &mut World) {
                 .in_set(FinishSystems::Diagnostics),
         ),
     );
+}
+
+/// Counts every quarantine, as it happens.
+fn count_quarantine(
+    event: On<Insert<Quarantined>>,
+    bodies: Query<&Quarantined>,
+    diag: Option<ResMut<PhysicsDiagnostics>>,
+) {
+    let entity = event.event().entity;
+    if let (Some(mut diag), Ok(q)) = (diag, bodies.get(entity)) {
+        diag.quarantined_total += 1;
+        diag.last_quarantined = Some((entity, q.reason.clone()));
+    }
 }
 
 fn timings_on(s: Res<DiagnosticsSettings>) -> bool {

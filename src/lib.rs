@@ -144,6 +144,7 @@ pub mod error;
 pub mod integrator;
 pub mod particles;
 pub mod quarantine;
+pub mod rest;
 pub mod rigid;
 pub mod scenes;
 pub mod schedule;
@@ -214,6 +215,9 @@ pub trait WorldPlugin: 'static {
     fn build(&self, world: &mut World);
 }
 
+/// Anything the substeps could move.
+type AnyBody = Or<(With<Mass>, With<Nodes>, With<Tracer>)>;
+
 /// Names of the plugins already built into a world, so adding one twice is harmless.
 #[derive(Resource, Default)]
 struct InstalledPlugins(Vec<core::any::TypeId>);
@@ -234,7 +238,7 @@ impl WorldPlugin for PhysicsCorePlugin {
         schedule::add_systems(
             world,
             PhysicsSchedule,
-            time::run_substeps.in_set(PhysicsSystems::Step),
+            time::run_substeps::<AnyBody>.in_set(PhysicsSystems::Step),
         );
         diagnostics::install(world);
         world.add_physics(IntegratorPlugin);

@@ -16,7 +16,6 @@ use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
 use bevy_ecs::world::DeferredWorld;
 
-use crate::diagnostics::PhysicsDiagnostics;
 use crate::error::Error;
 
 /// Why a body was taken out of the simulation.
@@ -47,23 +46,15 @@ pub struct BodyQuarantined {
     pub reason: QuarantineReason,
 }
 
-/// Remove hook of the validated components: removing a velocity makes a collider static.
-pub(crate) fn structure_changed(mut world: DeferredWorld, ctx: HookContext) {
-    crate::collision::mark_broad_phase_dirty(&mut world, ctx.entity);
-}
-
+/// Writes the message. Effects that care (diagnostics' counts, the broad phase's lists)
+/// observe the insert themselves: the core calls none of them.
 fn report_quarantine(mut world: DeferredWorld, ctx: HookContext) {
-    crate::collision::mark_broad_phase_dirty(&mut world, ctx.entity);
     let Some(reason) = world
         .get::<Quarantined>(ctx.entity)
         .map(|q| q.reason.clone())
     else {
         return;
     };
-    if let Some(mut diag) = world.get_resource_mut::<PhysicsDiagnostics>() {
-        diag.quarantined_total += 1;
-        diag.last_quarantined = Some((ctx.entity, reason.clone()));
-    }
     world.write_message(BodyQuarantined {
         entity: ctx.entity,
         reason,
@@ -82,15 +73,11 @@ pub(crate) trait Validate {
     fn validate(&self) -> Result<(), Error>;
 }
 
-/// Insert hook shared by every validated component: quarantine on a bad value. An insert
-/// on a collider's entity (a new pose for a static collider, a velocity that makes it move)
-/// also tells the broad phase to re-read its lists: that is how it learns of changes without
-/// scanning every collider each step.
+/// Insert hook shared by every validated component: quarantine on a bad value.
 pub(crate) fn validate_on_insert<T: Component + Validate>(
     mut world: DeferredWorld,
     ctx: HookContext,
 ) {
-    crate::collision::mark_broad_phase_dirty(&mut world, ctx.entity);
     let Some(Err(err)) = world.get::<T>(ctx.entity).map(Validate::validate) else {
         return;
     };

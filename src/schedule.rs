@@ -130,6 +130,19 @@ pub enum PrepareSystems {
     Collision,
 }
 
+/// The stages of [`PrepareSystems::Collision`]: contacts are found, sleeping islands that
+/// are about to be hit wake (the sleep plugin's), then the step's contact constraints are
+/// built from the bodies as they now are.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CollisionSystems {
+    /// Bounding boxes, broad phase, narrow phase, contact messages.
+    Detect,
+    /// Islands about to be hit wake.
+    Wake,
+    /// Contact constraints.
+    Constraints,
+}
+
 /// The stages of [`PhysicsSystems::Finish`]: derived poses first (colliders attached to
 /// bodies), then diagnostics, which read them.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -177,6 +190,15 @@ pub(crate) fn init_schedules(world: &mut World) {
         )
             .chain()
             .in_set(PhysicsSystems::Prepare),
+    );
+    physics.configure_sets(
+        (
+            CollisionSystems::Detect,
+            CollisionSystems::Wake,
+            CollisionSystems::Constraints,
+        )
+            .chain()
+            .in_set(PrepareSystems::Collision),
     );
     physics.configure_sets(
         (FinishSystems::Writeback, FinishSystems::Diagnostics)

@@ -29,21 +29,11 @@ use crate::rigid::{
     AngularMomentum, AngularVelocity, ExternalForceAtPoint, ExternalImpulseAtPoint, ExternalTorque,
     Rotation,
 };
-use crate::schedule::{PhysicsSchedule, PrepareSystems, add_systems};
+use crate::schedule::{CollisionSystems, PhysicsSchedule, PrepareSystems, add_systems};
 use crate::springs::Spring;
 use crate::time::PhysicsTime;
 
-/// Marks a body at rest: no system integrates it until it wakes. See the module docs.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Sleeping;
-
-/// Keeps a body from ever sleeping.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct SleepingDisabled;
-
-/// How long (s) the body has been slower than the sleep thresholds.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
-pub struct SleepTimer(pub f32);
+pub use crate::rest::{SleepTimer, Sleeping, SleepingDisabled};
 
 /// When islands fall asleep.
 #[derive(Resource, Debug, Clone, Copy, PartialEq)]
@@ -84,6 +74,13 @@ impl WorldPlugin for SleepPlugin {
                 .run_if(any_with_component::<Collider>)
                 .in_set(PrepareSystems::Sleep),
         );
+        add_systems(
+            world,
+            PhysicsSchedule,
+            wake_hit_islands
+                .run_if(any_with_component::<Sleeping>)
+                .in_set(CollisionSystems::Wake),
+        );
     }
 }
 
@@ -121,7 +118,7 @@ fn wake_on_user_change(
 /// impact: a ball fired at a sleeping box stopped dead and the box never moved.) Runs
 /// between the narrow phase and the contact constraints; its removals of [`Sleeping`] are
 /// applied before the constraints are built.
-pub(crate) fn wake_hit_islands(
+fn wake_hit_islands(
     mut commands: Commands,
     time: Res<PhysicsTime>,
     settings: Res<ContactSettings>,

@@ -9,7 +9,6 @@
 use bevy_ecs::prelude::*;
 
 use crate::error::{Error, Result};
-use crate::particles::{Mass, Nodes, Tracer};
 use crate::schedule::SubstepSchedule;
 
 /// The fixed step and the simulation clock.
@@ -183,12 +182,13 @@ pub struct FrameReport {
     pub dropped: f32,
 }
 
-/// Anything the substeps could move.
-type AnyBody = Or<(With<Mass>, With<Nodes>, With<Tracer>)>;
-
 /// Runs the substep schedule `substeps` times. The only system in `PhysicsSystems::Step`.
-/// A world without a single body only advances its clock.
-pub(crate) fn run_substeps(world: &mut World, bodies: &mut QueryState<(), AnyBody>) {
+/// A world where `Bodies` (the filter of anything the substeps could move, given by the
+/// core plugin) matches nothing only advances its clock.
+pub(crate) fn run_substeps<Bodies: bevy_ecs::query::QueryFilter>(
+    world: &mut World,
+    bodies: &mut QueryState<(), Bodies>,
+) {
     let Some(time) = world.get_resource::<PhysicsTime>() else {
         return;
     };

@@ -17,6 +17,9 @@
 //! the body. A part that is itself composite (a compound, trimesh or heightfield) cannot be
 //! nested in a compound: that child is quarantined with [`Error::CompositePart`].
 //!
+//! A part's own [`crate::Friction`], [`crate::Restitution`], [`crate::CollisionLayers`] and
+//! [`crate::Sensor`] are not read: the body's apply to all its parts.
+//!
 //! Changes are seen when they are inserted: a new collider, density or offset, a despawned
 //! or re-parented child, a new [`RigidBody`] kind. The work is done by a command queued from
 //! the component hooks, so it is complete before the next step.
@@ -203,9 +206,20 @@ pub(crate) fn on_child_of_discarded(
     }
 }
 
+/// A collider, or an entity that may have collider descendants.
+type ColliderOrParent = Or<(With<Collider>, With<Children>)>;
+
 /// Observer: an entity got a parent; a collider in its subtree may now be part of a body.
-pub(crate) fn on_child_of_inserted(event: On<Insert<ChildOf>>, mut commands: Commands) {
+pub(crate) fn on_child_of_inserted(
+    event: On<Insert<ChildOf>>,
+    candidates: Query<(), ColliderOrParent>,
+    mut commands: Commands,
+) {
     let child = event.event().entity;
+    // Hierarchies of a game are mostly not colliders (visuals, UI): skip those at once.
+    if !candidates.contains(child) {
+        return;
+    }
     commands.queue(move |world: &mut World| {
         if let Some(body) = owner(world, child) {
             refresh_body(world, body);

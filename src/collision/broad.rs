@@ -19,6 +19,10 @@ use glam::Vec3;
 use parry3d::bounding_volume::Aabb;
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
 
+use crate::particles::{LinearVelocity, Position};
+use crate::quarantine::Quarantined;
+use crate::rigid::Rotation;
+
 use super::CollisionLayers;
 use super::lanes::F4;
 
@@ -115,10 +119,40 @@ impl Default for BroadPhase {
     }
 }
 
-/// Marks both lists out of date. Called from the component hooks of [`super::Collider`], of
-/// every validated component (insert: a new pose or velocity; remove: a velocity taken away
-/// makes a collider static) and of [`crate::Quarantined`]: inserts and removals are how the
-/// broad phase learns about changes without scanning every collider each step.
+/// Marks both lists out of date. Called from the hooks of [`super::Collider`] and
+/// [`super::ColliderOf`], and from the collision plugin's observers of poses, velocities and
+/// quarantines (insert: a new pose or velocity; remove: a velocity taken away makes a
+/// collider static): inserts and removals are how the broad phase learns about changes
+/// without scanning every collider each step.
+/// Observer: a pose, velocity or quarantine was inserted on a collider's entity.
+pub(crate) fn on_body_inserted(
+    event: On<Insert<(Position, Rotation, LinearVelocity, Quarantined)>>,
+    colliders: Query<(), With<super::Collider>>,
+    bp: Option<ResMut<BroadPhase>>,
+) {
+    flag(event.event().entity, &colliders, bp);
+}
+
+/// Observer: a velocity, pose or quarantine was removed from a collider's entity.
+pub(crate) fn on_body_removed(
+    event: On<Remove<(Position, LinearVelocity, Quarantined)>>,
+    colliders: Query<(), With<super::Collider>>,
+    bp: Option<ResMut<BroadPhase>>,
+) {
+    flag(event.event().entity, &colliders, bp);
+}
+
+fn flag(
+    entity: Entity,
+    colliders: &Query<(), With<super::Collider>>,
+    bp: Option<ResMut<BroadPhase>>,
+) {
+    if let Some(mut bp) = bp.filter(|_| colliders.contains(entity)) {
+        bp.fixed_dirty = true;
+        bp.moving_dirty = true;
+    }
+}
+
 pub(crate) fn mark_dirty(world: &mut bevy_ecs::world::DeferredWorld, entity: Entity) {
     if world.get::<super::Collider>(entity).is_none() {
         return;

@@ -46,7 +46,6 @@ mod query;
 mod solver;
 
 pub use attach::{ColliderDensity, ColliderOf, ColliderOffset};
-pub(crate) use broad::mark_dirty as mark_broad_phase_dirty;
 pub use narrow::{ContactPair, Contacts};
 pub use plugin::CollisionPlugin;
 pub use query::{Hit, Projection, QueryFilter, SpatialQuery};
@@ -72,7 +71,7 @@ use crate::rigid::Rotation;
     Restitution,
     CollisionLayers,
     ColliderAabb,
-    crate::sleep::SleepTimer
+    crate::rest::SleepTimer
 )]
 #[cfg_attr(feature = "bevy", require(bevy_transform::components::Transform))]
 #[component(on_insert = collider_changed, on_remove = collider_changed)]

@@ -17,9 +17,11 @@ use super::{
 use crate::WorldPlugin;
 use crate::integrator::ConstraintsActive;
 use crate::particles::{LinearVelocity, Mass, Position};
+use crate::rest::Sleeping;
 use crate::rigid::{AngularVelocity, CenterOfMass, Inertia, Rotation};
-use crate::schedule::{PhysicsSchedule, PrepareSystems, StepSystems, SubstepSchedule, add_systems};
-use crate::sleep::Sleeping;
+use crate::schedule::{
+    CollisionSystems, PhysicsSchedule, StepSystems, SubstepSchedule, add_systems,
+};
 use crate::time::{PhysicsTime, SubstepTime};
 
 /// Colliders, contacts and the contact solver. Every system runs only while a collider
@@ -35,6 +37,8 @@ impl WorldPlugin for CollisionPlugin {
         world.init_resource::<ContactSolver>();
         world.init_resource::<bevy_ecs::message::Messages<ContactStarted>>();
         world.init_resource::<bevy_ecs::message::Messages<ContactEnded>>();
+        world.add_observer(super::broad::on_body_inserted);
+        world.add_observer(super::broad::on_body_removed);
         world.add_observer(super::attach::on_body_inserted);
         world.add_observer(super::attach::on_child_of_discarded);
         world.add_observer(super::attach::on_child_of_inserted);
@@ -49,17 +53,19 @@ impl WorldPlugin for CollisionPlugin {
             world,
             PhysicsSchedule,
             (
-                update_moving_aabbs,
-                update_fixed_aabbs.run_if(fixed_dirty),
-                run_broad_phase,
-                update_contacts,
-                trigger_contact_events.run_if(any_with_component::<super::CollisionEventsEnabled>),
-                crate::sleep::wake_hit_islands.run_if(any_with_component::<Sleeping>),
-                prepare_contacts,
+                (
+                    update_moving_aabbs,
+                    update_fixed_aabbs.run_if(fixed_dirty),
+                    run_broad_phase,
+                    update_contacts,
+                    trigger_contact_events
+                        .run_if(any_with_component::<super::CollisionEventsEnabled>),
+                )
+                    .chain()
+                    .in_set(CollisionSystems::Detect),
+                prepare_contacts.in_set(CollisionSystems::Constraints),
             )
-                .chain()
-                .run_if(any_with_component::<Collider>.or_else(has_contacts))
-                .in_set(PrepareSystems::Collision),
+                .run_if(any_with_component::<Collider>.or_else(has_contacts)),
         );
         add_systems(
             world,

@@ -61,7 +61,7 @@ impl WorldPlugin for IntegratorPlugin {
 }
 
 /// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::sleep::Sleeping>);
+type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
 
 /// Initialises every accumulator with the body's constant forces, f ← f_ext + m g s, and
 /// every torque accumulator with its constant torque, τ ← τ_ext.

@@ -21,7 +21,7 @@ use crate::schedule::ForceSchedule;
 use crate::time::SubstepTime;
 
 /// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::sleep::Sleeping>);
+type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
 
 const WEIGHT: [f32; 4] = [1.0, 2.0, 2.0, 1.0];
 const OFFSET: [f32; 3] = [0.5, 0.5, 1.0];

@@ -35,10 +35,7 @@ macro_rules! finite_vec_component {
     ($(#[$doc:meta])* $name:ident($ty:ty), $what:literal) => {
         $(#[$doc])*
         #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
-        #[component(
-            on_insert = validate_on_insert::<Self>,
-            on_remove = crate::quarantine::structure_changed
-        )]
+        #[component(on_insert = validate_on_insert::<Self>)]
         pub struct $name(pub $ty);
 
         impl Validate for $name {

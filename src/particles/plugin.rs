@@ -12,7 +12,7 @@ use crate::schedule::{ForceSystems, StepSystems, SubstepSchedule, add_force_syst
 use crate::time::SubstepTime;
 
 /// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::sleep::Sleeping>);
+type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
 
 /// Uniform gravity, f = m g s: installs the [`Gravity`] resource. Gravity is a constant
 /// force, so the core's force-clearing pass writes it into each accumulator (see

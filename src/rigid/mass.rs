@@ -246,6 +246,15 @@ pub(crate) fn insert_computed_mass(world: &mut World, body: Entity, props: MassP
         return;
     };
     let old_c = e.get::<CenterOfMass>().map_or(Vec3::ZERO, |c| c.0);
+    let same = e
+        .get::<ComputedMass>()
+        .is_some_and(|c| c.mass == props.mass)
+        && e.get::<Mass>() == Some(&mass)
+        && e.get::<Inertia>() == Some(&props.inertia)
+        && old_c == props.center_of_mass;
+    if same {
+        return;
+    }
     let q = e.get::<Rotation>().map_or(glam::Quat::IDENTITY, |r| r.0);
     let shift = q * (props.center_of_mass - old_c);
     if shift != Vec3::ZERO

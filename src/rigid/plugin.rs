@@ -19,7 +19,7 @@ use crate::schedule::{
 use crate::time::{PhysicsTime, SubstepTime};
 
 /// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::sleep::Sleeping>);
+type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
 
 /// Rotation, angular momentum, torque and renormalisation for bodies with [`Inertia`]. Every
 /// system runs only while such a body exists (or, for the optional inputs, while one has

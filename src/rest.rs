@@ -1,0 +1,20 @@
+//! Rest state that every integrating system skips: [`Sleeping`] bodies (put to sleep and
+//! woken by the sleep plugin), next to [`crate::Quarantined`] ones.
+//!
+//! These markers live in the core, not in the sleep plugin, so that particles, rigid bodies
+//! and contacts can skip sleeping bodies without depending on the plugin that decides who
+//! sleeps.
+
+use bevy_ecs::prelude::*;
+
+/// Marks a body at rest: no system integrates it until it wakes. See [`crate::sleep`].
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Sleeping;
+
+/// Keeps a body from ever sleeping.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct SleepingDisabled;
+
+/// How long (s) the body has been slower than the sleep thresholds.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+pub struct SleepTimer(pub f32);
