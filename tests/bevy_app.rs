@@ -401,3 +401,65 @@ fn extrapolation_renders_ahead_of_the_last_step_by_the_velocity() {
     }
     assert!(ahead > 30, "{ahead} frames ahead of the step");
 }
+
+#[test]
+fn despawning_mid_run_leaves_the_rest_running() {
+    let mut app = app(20.0);
+    let mut commands = app.world_mut().commands();
+    ground(&mut commands);
+    let keep = commands
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::ball(0.2).unwrap(),
+            Transform::from_xyz(0.0, 2.0, 0.0),
+            TransformInterpolation,
+        ))
+        .id();
+    let gone = commands
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::cuboid(0.2, 0.2, 0.2).unwrap(),
+            Transform::from_xyz(1.0, 0.2, 0.0),
+            TransformInterpolation,
+            CollisionEventsEnabled,
+        ))
+        .id();
+    let dumbbell = commands
+        .spawn((
+            RigidBody::Dynamic,
+            Transform::from_xyz(-3.0, 1.0, 0.0),
+            children![
+                (
+                    Collider::ball(0.2).unwrap(),
+                    Transform::from_xyz(-0.5, 0.0, 0.0)
+                ),
+                (
+                    Collider::ball(0.2).unwrap(),
+                    Transform::from_xyz(0.5, 0.0, 0.0)
+                ),
+            ],
+        ))
+        .id();
+    app.world_mut().flush();
+    frames(&mut app, 5);
+    app.world_mut().entity_mut(gone).despawn();
+    let part = app.world().get::<Children>(dumbbell).unwrap()[1];
+    app.world_mut().entity_mut(part).despawn();
+    frames(&mut app, 40);
+    let y = translation(&app, keep).y;
+    assert!((y - 0.2).abs() < 0.01, "the ball landed: {y}");
+    let m = app.world().get::<Mass>(dumbbell).unwrap().value();
+    let one = 1000.0 * 4.0 / 3.0 * std::f32::consts::PI * 0.008;
+    assert!((m - one).abs() < 0.01 * one, "one ball left: {m} kg");
+    let t = translation(&app, dumbbell);
+    assert!(
+        (t.y - 0.2).abs() < 0.02,
+        "the one-ball dumbbell rests on it: {t}"
+    );
+    assert_eq!(
+        app.world()
+            .resource::<PhysicsDiagnostics>()
+            .quarantined_total,
+        0
+    );
+}
