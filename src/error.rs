@@ -36,6 +36,16 @@ pub enum Error {
         /// The rejected value.
         value: f32,
     },
+    /// A quantity was outside its allowed range.
+    #[error("{what} must satisfy {range}, got {value}")]
+    OutOfRange {
+        /// Which input, e.g. `"Poisson ratio"`.
+        what: &'static str,
+        /// The rejected value.
+        value: f32,
+        /// The allowed range, as text.
+        range: &'static str,
+    },
     /// A spring was asked to join an entity to itself.
     #[error("a spring cannot connect entity {0} to itself")]
     SelfSpring(Entity),

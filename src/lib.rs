@@ -149,6 +149,7 @@ pub mod rigid;
 pub mod scenes;
 pub mod schedule;
 pub mod sleep;
+pub mod soft;
 pub mod springs;
 pub mod time;
 

@@ -1,0 +1,255 @@
+//! The material math of soft bodies, as pure functions of the deformation gradient F.
+//!
+//! For each [`StrainModel`]: the energy density Ψ(F) (J/m³), the first Piola–Kirchhoff stress
+//! P = ∂Ψ/∂F (Pa), and its differential dP[dF] = (∂P/∂F) : dF (Pa), which the implicit
+//! solver needs. The strains and the linear stress σ = λ tr(ε) I + 2 μ ε are the lecture's;
+//! see the [module docs](super) for the equations of each model and when to use it.
+
+use glam::{DMat3, Mat3, Vec3};
+
+use super::Lame;
+
+/// Green's finite strain E = ½ (FᵀF − I): exact under rotation, quadratic in positions.
+#[must_use]
+pub fn green_strain(f: Mat3) -> Mat3 {
+    0.5 * (f.transpose() * f - Mat3::IDENTITY)
+}
+
+/// Cauchy's infinitesimal strain ε = ½ (F + Fᵀ) − I: linear, but a rotation reads as strain.
+#[must_use]
+pub fn cauchy_strain(f: Mat3) -> Mat3 {
+    0.5 * (f + f.transpose()) - Mat3::IDENTITY
+}
+
+/// The co-rotated strain ε = S − I, with F = R S the polar decomposition: Cauchy's strain
+/// with the rotation taken out.
+#[must_use]
+pub fn corotated_strain(f: Mat3) -> Mat3 {
+    polar_decomposition(f).1 - Mat3::IDENTITY
+}
+
+/// The linear (isotropic, Hookean) stress σ = λ tr(ε) I + 2 μ ε (Pa).
+#[must_use]
+pub fn linear_stress(strain: Mat3, lame: Lame) -> Mat3 {
+    lame.lambda * trace(strain) * Mat3::IDENTITY + 2.0 * lame.mu * strain
+}
+
+/// F = R S with R a proper rotation (det R = +1) and S symmetric, through the SVD
+/// F = U Σ Vᵀ: R = U Vᵀ, S = V Σ Vᵀ. When det F < 0 (an inverted element) the smallest
+/// singular value is negated instead of letting R reflect, so S carries the inversion and
+/// the restoring force pushes the element back through (Irving, Teran and Fedkiw 2004).
+/// Computed in f64.
+#[must_use]
+pub fn polar_decomposition(f: Mat3) -> (Mat3, Mat3) {
+    let (r, s) = polar_f64(f.as_dmat3());
+    (r.as_mat3(), s.as_mat3())
+}
+
+fn polar_f64(f: DMat3) -> (DMat3, DMat3) {
+    let svd = glamx::DSvd3::from_matrix(f);
+    let (mut u, mut sigma, mut v) = (svd.u, svd.s, svd.vt.transpose());
+    // Make U and V proper rotations; each flip keeps F = U Σ Vᵀ by moving the sign into the
+    // smallest singular value (they come sorted descending), which ends with the sign of
+    // det F.
+    if u.determinant() < 0.0 {
+        u.z_axis = -u.z_axis;
+        sigma.z = -sigma.z;
+    }
+    if v.determinant() < 0.0 {
+        v.z_axis = -v.z_axis;
+        sigma.z = -sigma.z;
+    }
+    let r = u * v.transpose();
+    let s = v * DMat3::from_diagonal(sigma) * v.transpose();
+    (r, symmetric(s))
+}
+
+fn symmetric(m: DMat3) -> DMat3 {
+    0.5 * (m + m.transpose())
+}
+
+fn trace(m: Mat3) -> f32 {
+    m.x_axis.x + m.y_axis.y + m.z_axis.z
+}
+
+/// A : B = Σ Aᵢⱼ Bᵢⱼ.
+#[must_use]
+pub fn ddot(a: Mat3, b: Mat3) -> f32 {
+    a.x_axis.dot(b.x_axis) + a.y_axis.dot(b.y_axis) + a.z_axis.dot(b.z_axis)
+}
+
+/// ∂J/∂F for J = det F: the cofactor matrix, column i the cross product of the other two.
+#[must_use]
+pub fn cofactor(f: Mat3) -> Mat3 {
+    Mat3::from_cols(
+        f.y_axis.cross(f.z_axis),
+        f.z_axis.cross(f.x_axis),
+        f.x_axis.cross(f.y_axis),
+    )
+}
+
+/// d(cof F)[dF], the derivative of [`cofactor`] along dF.
+fn cofactor_differential(f: Mat3, df: Mat3) -> Mat3 {
+    Mat3::from_cols(
+        df.y_axis.cross(f.z_axis) + f.y_axis.cross(df.z_axis),
+        df.z_axis.cross(f.x_axis) + f.z_axis.cross(df.x_axis),
+        df.x_axis.cross(f.y_axis) + f.x_axis.cross(df.y_axis),
+    )
+}
+
+/// The skew matrix [w]× with [w]× v = w × v.
+fn cross_matrix(w: Vec3) -> Mat3 {
+    Mat3::from_cols(
+        Vec3::new(0.0, w.z, -w.y),
+        Vec3::new(-w.z, 0.0, w.x),
+        Vec3::new(w.y, -w.x, 0.0),
+    )
+}
+
+/// How a soft body's material measures strain: the dial between cost and fidelity. See the
+/// [module docs](super).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StrainModel {
+    /// Green's strain with the linear stress (St. Venant–Kirchhoff): rotation-exact, stiffens
+    /// in stretch, and collapses under strong compression (no resistance to inversion).
+    Green,
+    /// Cauchy's strain with the linear stress: the cheapest, exact for small displacements,
+    /// but a rigid rotation by θ stores the ghost energy density 2 (μ + λ)(1 − cos θ)².
+    Cauchy,
+    /// Co-rotated: Cauchy's strain after the polar decomposition removes the rotation. The
+    /// graphics workhorse; recovers from inversion.
+    #[default]
+    Corotated,
+    /// Stable Neo-Hookean: nonlinear, volume-preserving, defined and restoring through
+    /// inversion, with no singularity at J = 0.
+    StableNeoHookean,
+}
+
+/// Ψ and P of one model at one F.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Stress {
+    /// Energy density Ψ (J/m³).
+    pub energy: f32,
+    /// First Piola–Kirchhoff stress P = ∂Ψ/∂F (Pa).
+    pub piola: Mat3,
+}
+
+impl StrainModel {
+    /// Every model, in order of the enum.
+    pub const ALL: [StrainModel; 4] = [
+        StrainModel::Green,
+        StrainModel::Cauchy,
+        StrainModel::Corotated,
+        StrainModel::StableNeoHookean,
+    ];
+
+    /// A short lowercase name (for reports).
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            StrainModel::Green => "green",
+            StrainModel::Cauchy => "cauchy",
+            StrainModel::Corotated => "corotated",
+            StrainModel::StableNeoHookean => "neohookean",
+        }
+    }
+
+    /// Ψ(F) and P(F).
+    #[must_use]
+    pub fn stress(self, f: Mat3, lame: Lame) -> Stress {
+        let Lame { mu, lambda } = lame;
+        match self {
+            StrainModel::Green => {
+                let e = green_strain(f);
+                let s = linear_stress(e, lame);
+                Stress {
+                    energy: mu * ddot(e, e) + 0.5 * lambda * trace(e).powi(2),
+                    piola: f * s,
+                }
+            }
+            StrainModel::Cauchy => {
+                let e = cauchy_strain(f);
+                Stress {
+                    energy: mu * ddot(e, e) + 0.5 * lambda * trace(e).powi(2),
+                    piola: linear_stress(e, lame),
+                }
+            }
+            StrainModel::Corotated => {
+                let (r, s) = polar_decomposition(f);
+                let e = s - Mat3::IDENTITY;
+                Stress {
+                    energy: mu * ddot(e, e) + 0.5 * lambda * trace(e).powi(2),
+                    piola: 2.0 * mu * (f - r) + lambda * trace(e) * r,
+                }
+            }
+            StrainModel::StableNeoHookean => {
+                // λ + μ so that small strains meet linear elasticity (see the module docs).
+                let l = lambda + mu;
+                let j = f.determinant();
+                let c = cofactor(f);
+                Stress {
+                    energy: 0.5 * mu * (ddot(f, f) - 3.0) - mu * (j - 1.0)
+                        + 0.5 * l * (j - 1.0).powi(2),
+                    piola: mu * f + (l * (j - 1.0) - mu) * c,
+                }
+            }
+        }
+    }
+
+    /// The energy density Ψ(F) (J/m³).
+    #[must_use]
+    pub fn energy_density(self, f: Mat3, lame: Lame) -> f32 {
+        self.stress(f, lame).energy
+    }
+
+    /// The first Piola–Kirchhoff stress P(F) (Pa).
+    #[must_use]
+    pub fn first_piola(self, f: Mat3, lame: Lame) -> Mat3 {
+        self.stress(f, lame).piola
+    }
+
+    /// dP[dF] = (∂P/∂F) : dF (Pa), the stress differential along dF.
+    #[must_use]
+    pub fn differential(self, f: Mat3, df: Mat3, lame: Lame) -> Mat3 {
+        let Lame { mu, lambda } = lame;
+        match self {
+            StrainModel::Green => {
+                let e = green_strain(f);
+                let de = 0.5 * (df.transpose() * f + f.transpose() * df);
+                df * linear_stress(e, lame) + f * linear_stress(de, lame)
+            }
+            StrainModel::Cauchy => lambda * trace(df) * Mat3::IDENTITY + mu * (df + df.transpose()),
+            StrainModel::Corotated => {
+                let (r, s) = polar_decomposition(f);
+                let dr = rotation_differential(r, s, df);
+                let e = trace(s) - 3.0;
+                2.0 * mu * df
+                    + lambda * trace(r.transpose() * df) * r
+                    + (lambda * e - 2.0 * mu) * dr
+            }
+            StrainModel::StableNeoHookean => {
+                let l = lambda + mu;
+                let j = f.determinant();
+                let c = cofactor(f);
+                mu * df + l * ddot(c, df) * c + (l * (j - 1.0) - mu) * cofactor_differential(f, df)
+            }
+        }
+    }
+}
+
+/// dR for F = R S moved by dF: RᵀdR = [ω]× with (tr S · I − S) ω = axial(RᵀdF − dFᵀR), from
+/// the skew part of RᵀdF = [ω]× S + dS. Where two singular values sum to zero (a flat
+/// element flipping) the system is singular; ω is then taken from its regular part.
+fn rotation_differential(r: Mat3, s: Mat3, df: Mat3) -> Mat3 {
+    let m = r.transpose() * df;
+    let a = m - m.transpose();
+    let axial = Vec3::new(a.y_axis.z, a.z_axis.x, a.x_axis.y);
+    let g = trace(s) * Mat3::IDENTITY - s;
+    let det = g.determinant();
+    let omega = if det.abs() > 1e-12 * (1.0 + trace(s).abs().powi(3)) {
+        g.inverse() * axial
+    } else {
+        Vec3::ZERO
+    };
+    r * cross_matrix(omega)
+}
