@@ -60,6 +60,8 @@ pub struct PhysicsDiagnostics {
     pub gravitational_energy: f64,
     /// Elastic energy stored in springs (J).
     pub spring_energy: f64,
+    /// Elastic energy stored in soft bodies (J), from their last force evaluation.
+    pub elastic_energy: f64,
     /// Total linear momentum (kg·m/s).
     pub linear_momentum: Vec3,
     /// Entity counts.
@@ -77,10 +79,10 @@ pub struct PhysicsDiagnostics {
 }
 
 impl PhysicsDiagnostics {
-    /// Kinetic + gravitational + spring energy (J).
+    /// Kinetic + gravitational + spring + soft-body elastic energy (J).
     #[must_use]
     pub fn total_energy(&self) -> f64 {
-        self.kinetic_energy + self.gravitational_energy + self.spring_energy
+        self.kinetic_energy + self.gravitational_energy + self.spring_energy + self.elastic_energy
     }
 
     /// Wall time of one set in the last step.

@@ -36,6 +36,14 @@ pub enum Error {
         /// The rejected value.
         value: f32,
     },
+    /// A tetrahedron of a mesh has repeated corners or (almost) no volume.
+    #[error("tetrahedron {index} is degenerate (rest volume {volume} m³)")]
+    DegenerateElement {
+        /// Which tetrahedron.
+        index: usize,
+        /// Its signed rest volume (m³).
+        volume: f32,
+    },
     /// A quantity was outside its allowed range.
     #[error("{what} must satisfy {range}, got {value}")]
     OutOfRange {

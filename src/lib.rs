@@ -38,6 +38,7 @@
 //! | [`RigidBodyPlugin`] | orientation, angular momentum, torque, renormalisation | [`Inertia`] ([`RigidBody`]) |
 //! | [`CollisionPlugin`] | broad and narrow phase, contact solver, contact messages, [`SpatialQuery`], mass from colliders, child colliders | [`Collider`] |
 //! | [`SleepPlugin`] | resting islands stop costing anything | [`Collider`] bodies |
+//! | [`soft::SoftBodyPlugin`] | tetrahedral FEM: elastic forces of the four strain models | [`soft::SoftBody`] |
 //!
 //! With the `bevy` feature, [`PhysicsPlugins`] is also a Bevy `PluginGroup`, every plugin above
 //! a Bevy `Plugin`, and [`bevy`] adds the App clock, `Transform` sync, interpolation and
@@ -260,7 +261,8 @@ impl WorldPlugin for PhysicsPlugins {
             .add_physics(SpringPlugin)
             .add_physics(RigidBodyPlugin)
             .add_physics(CollisionPlugin)
-            .add_physics(SleepPlugin);
+            .add_physics(SleepPlugin)
+            .add_physics(soft::SoftBodyPlugin);
     }
 }
 

@@ -1,8 +1,10 @@
 //! Soft bodies: the material models of tetrahedral FEM.
 //!
-//! **This module holds the material math only** (issue 12 builds the rest on it: meshes, the
-//! `SoftBody` component and plugin, the implicit solver). Everything here is a pure function
-//! of the deformation gradient, tested against closed forms.
+//! A [`SoftBody`] is one entity per tetrahedral mesh ([`TetMesh`]): its nodes are a
+//! [`Nodes`] component, its elements live in the [`SoftBody`] component, and
+//! [`SoftBodyPlugin`] adds their elastic forces in [`crate::ForceSystems::Elasticity`], so
+//! every integrator of the dial advances it. The material math is pure functions of the
+//! deformation gradient ([`strain`]), tested against closed forms.
 //!
 //! **Deformation gradient.** A tetrahedron with rest corners X₀..X₃ and current corners
 //! x₀..x₃ maps rest edges to current edges linearly: F = Ds Dm⁻¹, with Ds = [x₁−x₀, x₂−x₀,
@@ -27,11 +29,19 @@
 //! Eberle's course notes (2020), without the −½ μ log(I_C + 1) term, with λ′ = λ + μ so that
 //! small strains match linear elasticity. Units: Pa for E, μ, λ, P; J/m³ for Ψ.
 
+pub mod mesh;
+mod plugin;
 pub mod strain;
 
+pub use mesh::{CellSplit, TetMesh};
+pub use plugin::SoftBodyPlugin;
 pub use strain::{StrainModel, Stress};
 
+use bevy_ecs::prelude::*;
+use glam::{Mat3, Vec3, Vec3A};
+
 use crate::error::{Error, Result, finite, non_negative, positive};
+use crate::particles::Nodes;
 
 /// The Lamé parameters μ (shear modulus) and λ (Pa).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -122,5 +132,171 @@ impl Material {
             mu: e / (2.0 * (1.0 + nu)),
             lambda: e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu)),
         }
+    }
+}
+
+/// What a soft body's last force evaluation found: elastic energy, volume and inversion.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct SoftBodyStats {
+    /// Elastic energy Σ V Ψ(F) (J).
+    pub elastic_energy: f32,
+    /// Current volume over rest volume, Σ V J / Σ V.
+    pub volume_ratio: f32,
+    /// Tetrahedra with det F ≤ 0.
+    pub inverted: usize,
+}
+
+/// A tetrahedral soft body: the cold state of one mesh (tetrahedra, Dm⁻¹, rest volumes,
+/// material, strain model). Its hot state is the [`Nodes`] component on the same entity
+/// (positions, velocities, forces, inverse lumped masses), so gravity, damping, velocity
+/// fields, every integrator and the quarantine act on its nodes as on any mesh. Spawn both
+/// with [`SoftBody::build`].
+#[derive(Component, Debug, Clone, PartialEq)]
+#[require(Nodes)]
+pub struct SoftBody {
+    tets: Vec<[u32; 4]>,
+    dm_inv: Vec<Mat3>,
+    volume: Vec<f32>,
+    material: Material,
+    lame: Lame,
+    model: StrainModel,
+    stats: SoftBodyStats,
+}
+
+impl SoftBody {
+    /// The nodes and the body of `mesh` placed at `offset` (m), with masses lumped from the
+    /// material's density (each tetrahedron gives a quarter of ρ V to each corner).
+    ///
+    /// # Errors
+    /// [`Error::NonFinite`] for a bad offset; [`Error::InvalidMass`] if a node gets no mass.
+    pub fn build(
+        mesh: &TetMesh,
+        offset: Vec3,
+        material: Material,
+        model: StrainModel,
+    ) -> Result<(Nodes, SoftBody)> {
+        let offset = crate::error::finite_vec("soft body offset", offset)?;
+        let points = mesh.points();
+        let mut mass = vec![0.0f32; points.len()];
+        let (mut dm_inv, mut volume) = (Vec::new(), Vec::new());
+        for t in mesh.tets() {
+            let p = |i: usize| points[t[i] as usize];
+            let dm = Mat3::from_cols(p(1) - p(0), p(2) - p(0), p(3) - p(0));
+            let v = dm.determinant() / 6.0;
+            dm_inv.push(dm.inverse());
+            volume.push(v);
+            for &i in t {
+                mass[i as usize] += 0.25 * material.density() * v;
+            }
+        }
+        let mut nodes = Nodes::with_capacity(points.len());
+        for (p, m) in points.iter().zip(mass) {
+            nodes.push(*p + offset, Vec3::ZERO, m)?;
+        }
+        let body = SoftBody {
+            tets: mesh.tets().to_vec(),
+            dm_inv,
+            volume,
+            material,
+            lame: material.lame(),
+            model,
+            stats: SoftBodyStats::default(),
+        };
+        Ok((nodes, body))
+    }
+
+    /// The tetrahedra (indices into the nodes).
+    #[must_use]
+    pub fn tets(&self) -> &[[u32; 4]] {
+        &self.tets
+    }
+
+    /// The material.
+    #[must_use]
+    pub fn material(&self) -> Material {
+        self.material
+    }
+
+    /// The strain model.
+    #[must_use]
+    pub fn model(&self) -> StrainModel {
+        self.model
+    }
+
+    /// Changes the strain model (takes effect at the next force evaluation).
+    pub fn set_model(&mut self, model: StrainModel) {
+        self.model = model;
+    }
+
+    /// What the last force evaluation found.
+    #[must_use]
+    pub fn stats(&self) -> SoftBodyStats {
+        self.stats
+    }
+
+    /// Total rest volume (m³).
+    #[must_use]
+    pub fn rest_volume(&self) -> f32 {
+        self.volume.iter().sum()
+    }
+
+    /// F = Ds Dm⁻¹ of tetrahedron `k` at positions `x`.
+    #[must_use]
+    pub fn deformation_gradient(&self, x: &[Vec3A], k: usize) -> Mat3 {
+        let t = self.tets[k];
+        let p = |i: usize| Vec3::from(x[t[i] as usize]);
+        Mat3::from_cols(p(1) - p(0), p(2) - p(0), p(3) - p(0)) * self.dm_inv[k]
+    }
+
+    /// Adds the elastic (and Rayleigh stiffness-damping) forces of every tetrahedron into
+    /// `f`, and the mass damping −α m v; records the stats. Returns false if a force came out
+    /// non-finite (nothing is then trusted).
+    pub(crate) fn accumulate(
+        &mut self,
+        x: &[Vec3A],
+        v: &[Vec3A],
+        m: &[f32],
+        f: &mut [Vec3A],
+    ) -> bool {
+        let (alpha, beta) = self.material.damping();
+        let mut stats = SoftBodyStats::default();
+        let (mut vj, mut vsum) = (0.0f32, 0.0f32);
+        let mut finite = true;
+        for k in 0..self.tets.len() {
+            let t = self.tets[k];
+            let (dm_inv, vol) = (self.dm_inv[k], self.volume[k]);
+            let f_k = self.deformation_gradient(x, k);
+            let s = self.model.stress(f_k, self.lame);
+            let mut p = s.piola;
+            if beta > 0.0 {
+                let dv = |i: usize| Vec3::from(v[t[i] as usize] - v[t[0] as usize]);
+                let df = Mat3::from_cols(dv(1), dv(2), dv(3)) * dm_inv;
+                p += beta * self.model.differential(f_k, df, self.lame);
+            }
+            let h = -vol * p * dm_inv.transpose();
+            let (h1, h2, h3) = (
+                Vec3A::from(h.x_axis),
+                Vec3A::from(h.y_axis),
+                Vec3A::from(h.z_axis),
+            );
+            f[t[1] as usize] += h1;
+            f[t[2] as usize] += h2;
+            f[t[3] as usize] += h3;
+            f[t[0] as usize] -= h1 + h2 + h3;
+            finite &= h.is_finite();
+            let j = f_k.determinant();
+            stats.elastic_energy += vol * s.energy;
+            stats.inverted += usize::from(j <= 0.0);
+            vj += vol * j;
+            vsum += vol;
+        }
+        if alpha > 0.0 {
+            for i in 0..f.len() {
+                f[i] -= alpha * m[i] * v[i];
+            }
+        }
+        stats.volume_ratio = vj / vsum;
+        self.stats = stats;
+        finite
     }
 }

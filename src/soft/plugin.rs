@@ -1,0 +1,66 @@
+//! Soft-body systems: elastic forces, and their energy in the diagnostics.
+
+use bevy_ecs::prelude::*;
+
+use super::SoftBody;
+use crate::WorldPlugin;
+use crate::diagnostics::PhysicsDiagnostics;
+use crate::particles::Nodes;
+use crate::quarantine::{QuarantineReason, Quarantined};
+use crate::schedule::{
+    FinishSystems, ForceSystems, PhysicsSchedule, add_force_systems, add_systems,
+};
+
+/// Elastic forces of [`SoftBody`] meshes. Its systems run only while a soft body exists.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct SoftBodyPlugin;
+
+impl WorldPlugin for SoftBodyPlugin {
+    fn build(&self, world: &mut World) {
+        add_force_systems(world, || {
+            apply_elastic_forces
+                .run_if(any_with_component::<SoftBody>)
+                .in_set(ForceSystems::Elasticity)
+        });
+        add_systems(
+            world,
+            PhysicsSchedule,
+            report_elastic_energy
+                .run_if(any_with_component::<SoftBody>)
+                .in_set(FinishSystems::Writeback),
+        );
+    }
+}
+
+type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
+
+/// f += −V P(F) Dm⁻ᵀ per tetrahedron; a body whose forces come out non-finite is quarantined.
+fn apply_elastic_forces(
+    mut commands: Commands,
+    mut bodies: Query<(Entity, &mut Nodes, &mut SoftBody), Live>,
+) {
+    for (e, mut nodes, mut body) in &mut bodies {
+        let n = nodes.bypass_change_detection();
+        let ok = body
+            .bypass_change_detection()
+            .accumulate(&n.x, &n.v, &n.mass, &mut n.f);
+        if !ok {
+            commands.entity(e).insert(Quarantined {
+                reason: QuarantineReason::NonFiniteState,
+            });
+        }
+    }
+}
+
+/// Σ elastic energy into [`PhysicsDiagnostics::elastic_energy`].
+fn report_elastic_energy(
+    bodies: Query<&SoftBody, Without<Quarantined>>,
+    diag: Option<ResMut<PhysicsDiagnostics>>,
+) {
+    if let Some(mut diag) = diag {
+        diag.elastic_energy = bodies
+            .iter()
+            .map(|b| f64::from(b.stats().elastic_energy))
+            .sum();
+    }
+}
