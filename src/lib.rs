@@ -167,7 +167,9 @@ pub use collision::{
 };
 pub use diagnostics::{DiagnosticsSettings, PhysicsDiagnostics};
 pub use error::{Error, Result};
-pub use integrator::{ConstraintsActive, Integrator, IntegratorOverride, IntegratorPlugin};
+pub use integrator::{
+    ConstraintsActive, ImplicitEuler, Integrator, IntegratorOverride, IntegratorPlugin,
+};
 pub use particles::{
     Advection, DampingPlugin, ExternalForce, ExternalImpulse, Force, Gravity, GravityPlugin,
     GravityScale, LinearDamping, LinearVelocity, Mass, Nodes, ParticleBundle, Position, Tracer,

@@ -34,6 +34,13 @@ mod plugin;
 mod stages;
 
 pub use plugin::{ConstraintsActive, IntegratorPlugin};
+
+/// Meshes the explicit integrators advance: alive, awake, and not solved implicitly.
+pub(crate) type ExplicitMesh = (
+    Without<crate::quarantine::Quarantined>,
+    Without<crate::rest::Sleeping>,
+    Without<ImplicitEuler>,
+);
 pub use stages::{AngularRk4, Rk4Scratch};
 
 use bevy_ecs::prelude::*;
@@ -98,6 +105,40 @@ impl Integrator {
     #[must_use]
     pub const fn is_multistage(self) -> bool {
         matches!(self, Integrator::VelocityVerlet | Integrator::Rk4)
+    }
+}
+
+/// Backward (implicit) Euler for one mesh, in place of the explicit integrators:
+/// v₁ = v₀ + h M⁻¹ f(x₁, v₁), x₁ = x₀ + h v₁, solved by Newton's method on the incremental
+/// potential ½ (x − y)ᵀ M (x − y) / h² + U(x) − f_extᵀ x with y = x₀ + h v₀, each Newton step a
+/// Jacobi-preconditioned conjugate-gradient solve with the element Hessians projected to be
+/// positive semi-definite, and a backtracking line search on the potential. Pinned nodes
+/// (zero inverse mass) move with their velocity and are filtered out of the solve.
+///
+/// Unconditionally stable: the step never adds energy, whatever the stiffness and h. It is
+/// first order and damps: an undamped oscillator loses the factor 1/(1 + ω²h²) of its energy
+/// per step. Put it on an entity beside the mesh ([`crate::soft::SoftBody`]); the constant
+/// forces of the step (gravity, external, damping) enter as f_ext.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+pub struct ImplicitEuler {
+    /// Newton stops when the gradient's norm has fallen below this fraction of its first
+    /// value (dimensionless; default 1e-3), or when it stalls at the floor that f32
+    /// positions set (about 1e-4 of the first gradient on a stiff body).
+    pub tolerance: f32,
+    /// Newton iterations per substep at most (default 8).
+    pub max_newton: u32,
+    /// Conjugate-gradient iterations per Newton step at most (default 200); each solve stops
+    /// at a relative residual of 1e-3.
+    pub max_cg: u32,
+}
+
+impl Default for ImplicitEuler {
+    fn default() -> Self {
+        Self {
+            tolerance: 1e-3,
+            max_newton: 8,
+            max_cg: 200,
+        }
     }
 }
 

@@ -198,7 +198,7 @@ fn integrate_velocities(
         Query<(BodyState, &IntegratorOverride), Live>,
         Suspects,
     )>,
-    mut meshes: Query<(&mut Nodes, Option<&IntegratorOverride>), Live>,
+    mut meshes: Query<(&mut Nodes, Option<&IntegratorOverride>), super::ExplicitMesh>,
 ) {
     let h = time.h;
     let method = *global;
@@ -279,7 +279,7 @@ fn integrate_positions(
         Query<(Drift, &IntegratorOverride), (With<Mass>, Live)>,
         Suspects,
     )>,
-    mut meshes: Query<(Entity, &mut Nodes, Option<&IntegratorOverride>), Live>,
+    mut meshes: Query<(Entity, &mut Nodes, Option<&IntegratorOverride>), super::ExplicitMesh>,
 ) {
     let h = time.h;
     let method = *global;

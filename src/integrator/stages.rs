@@ -144,7 +144,7 @@ type StageRotation<'a> = (
 pub(crate) fn complete_stages(
     world: &mut World,
     bodies: &mut QueryState<StageBody, Live>,
-    meshes: &mut QueryState<(Entity, &mut Nodes, Option<&IntegratorOverride>), Live>,
+    meshes: &mut QueryState<(Entity, &mut Nodes, Option<&IntegratorOverride>), super::ExplicitMesh>,
     rotations: &mut QueryState<StageRotation, Live>,
     mut scratch: Local<StageScratch>,
 ) {

@@ -118,6 +118,18 @@ impl Nodes {
         Ok(())
     }
 
+    /// Adds `f` (N) to node `i`'s force accumulator, for a force system placed in
+    /// [`crate::ForceSystems::User`] (a point load, a grab). The accumulator is reset every
+    /// evaluation, so the force acts only while the system keeps adding it.
+    ///
+    /// # Errors
+    /// [`Error::IndexOutOfRange`] or [`Error::NonFinite`].
+    pub fn add_force(&mut self, i: usize, f: Vec3A) -> Result<()> {
+        self.check(i)?;
+        self.f[i] += Vec3A::from(finite_vec("node force", f.into())?);
+        Ok(())
+    }
+
     /// Number of nodes.
     #[must_use]
     pub fn len(&self) -> usize {

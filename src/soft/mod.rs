@@ -29,10 +29,12 @@
 //! Eberle's course notes (2020), without the −½ μ log(I_C + 1) term, with λ′ = λ + μ so that
 //! small strains match linear elasticity. Units: Pa for E, μ, λ, P; J/m³ for Ψ.
 
+mod implicit;
 pub mod mesh;
 mod plugin;
 pub mod strain;
 
+pub use implicit::ImplicitReport;
 pub use mesh::{CellSplit, TetMesh};
 pub use plugin::SoftBodyPlugin;
 pub use strain::{StrainModel, Stress};
@@ -144,6 +146,8 @@ pub struct SoftBodyStats {
     pub volume_ratio: f32,
     /// Tetrahedra with det F ≤ 0.
     pub inverted: usize,
+    /// The last implicit substep's solve (zero under the explicit integrators).
+    pub implicit: ImplicitReport,
 }
 
 /// A tetrahedral soft body: the cold state of one mesh (tetrahedra, Dm⁻¹, rest volumes,
@@ -296,6 +300,7 @@ impl SoftBody {
             }
         }
         stats.volume_ratio = vj / vsum;
+        stats.implicit = self.stats.implicit;
         self.stats = stats;
         finite
     }

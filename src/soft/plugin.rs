@@ -5,11 +5,14 @@ use bevy_ecs::prelude::*;
 use super::SoftBody;
 use crate::WorldPlugin;
 use crate::diagnostics::PhysicsDiagnostics;
+use crate::integrator::ImplicitEuler;
 use crate::particles::Nodes;
 use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::schedule::{
-    FinishSystems, ForceSystems, PhysicsSchedule, add_force_systems, add_systems,
+    FinishSystems, ForceSystems, IntegrationSystems, PhysicsSchedule, SubstepSchedule,
+    add_force_systems, add_systems,
 };
+use crate::time::SubstepTime;
 
 /// Elastic forces of [`SoftBody`] meshes. Its systems run only while a soft body exists.
 #[derive(Debug, Default, Clone, Copy)]
@@ -22,6 +25,13 @@ impl WorldPlugin for SoftBodyPlugin {
                 .run_if(any_with_component::<SoftBody>)
                 .in_set(ForceSystems::Elasticity)
         });
+        add_systems(
+            world,
+            SubstepSchedule,
+            solve_implicit
+                .run_if(any_with_component::<ImplicitEuler>)
+                .in_set(IntegrationSystems::Integrate),
+        );
         add_systems(
             world,
             PhysicsSchedule,
@@ -37,7 +47,7 @@ type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
 /// f += −V P(F) Dm⁻ᵀ per tetrahedron; a body whose forces come out non-finite is quarantined.
 fn apply_elastic_forces(
     mut commands: Commands,
-    mut bodies: Query<(Entity, &mut Nodes, &mut SoftBody), Live>,
+    mut bodies: Query<(Entity, &mut Nodes, &mut SoftBody), (Live, Without<ImplicitEuler>)>,
 ) {
     for (e, mut nodes, mut body) in &mut bodies {
         let n = nodes.bypass_change_detection();
@@ -48,6 +58,33 @@ fn apply_elastic_forces(
             commands.entity(e).insert(Quarantined {
                 reason: QuarantineReason::NonFiniteState,
             });
+        }
+    }
+}
+
+/// Backward Euler for soft bodies with [`ImplicitEuler`]; one that turns non-finite is
+/// quarantined.
+fn solve_implicit(
+    mut commands: Commands,
+    time: Res<SubstepTime>,
+    mut bodies: Query<(Entity, &mut Nodes, &mut SoftBody, &ImplicitEuler), Live>,
+    mut scratch: Local<super::implicit::Scratch>,
+) {
+    for (e, mut nodes, mut body, settings) in &mut bodies {
+        let body = body.bypass_change_detection();
+        match super::implicit::step(
+            body,
+            nodes.bypass_change_detection(),
+            settings,
+            time.h,
+            &mut scratch,
+        ) {
+            Some(report) => body.stats.implicit = report,
+            None => {
+                commands.entity(e).insert(Quarantined {
+                    reason: QuarantineReason::NonFiniteState,
+                });
+            }
         }
     }
 }
