@@ -14,6 +14,7 @@
 mod bevy_layer;
 mod contacts;
 mod rigid;
+mod soft;
 #[path = "../common/timing.rs"]
 mod timing;
 
@@ -379,7 +380,7 @@ fn main() {
         "{:<48} {:>14} {:>14} {:>7}  note",
         "name", "ours_ns", "reference_ns", "ratio"
     );
-    // `--only particles|rigid|contacts|bevy|dial` runs one group (bevy with `--features bevy`).
+    // `--only particles|rigid|contacts|soft|bevy|dial` runs one group (bevy with `--features bevy`).
     let only = std::env::args()
         .skip_while(|a| a != "--only")
         .nth(1)
@@ -398,6 +399,9 @@ fn main() {
     }
     if run("contacts") {
         contacts::contact_scenes(&cfg, quick);
+    }
+    if run("soft") {
+        soft::soft_lines(&cfg);
     }
     #[cfg(feature = "bevy")]
     if run("bevy") {

@@ -74,12 +74,12 @@ fn vec9(m: DMat3) -> [f64; 9] {
 /// semi-definite (`None` when it already is).
 fn element_hessian(body: &SoftBody, f: Mat3) -> ([f64; 81], Option<[f64; 81]>) {
     let mut h = M9::zeros();
-    for j in 0..9 {
-        let mut e = [0.0f32; 9];
-        e[j] = 1.0;
-        let dp = body
-            .model
-            .differential(f, Mat3::from_cols_array(&e), body.lame);
+    for (j, dp) in body
+        .model
+        .differentials(f, body.lame)
+        .into_iter()
+        .enumerate()
+    {
         for (i, v) in dp.to_cols_array().into_iter().enumerate() {
             h[(i, j)] = f64::from(v);
         }

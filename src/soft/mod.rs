@@ -252,6 +252,13 @@ impl SoftBody {
         Mat3::from_cols(p(1) - p(0), p(2) - p(0), p(3) - p(0)) * self.dm_inv[k]
     }
 
+    /// Adds this body's elastic and damping forces (N) into `nodes`' force accumulator, as
+    /// the plugin does in every force evaluation; records [`SoftBody::stats`]. Returns false
+    /// if a force came out non-finite.
+    pub fn add_elastic_forces(&mut self, nodes: &mut Nodes) -> bool {
+        self.accumulate(&nodes.x, &nodes.v, &nodes.mass, &mut nodes.f)
+    }
+
     /// Adds the elastic (and Rayleigh stiffness-damping) forces of every tetrahedron into
     /// `f`, and the mass damping −α m v; records the stats. Returns false if a force came out
     /// non-finite (nothing is then trusted).

@@ -237,6 +237,55 @@ impl StrainModel {
     }
 }
 
+impl StrainModel {
+    /// dP[Eᵢⱼ] for the nine unit directions Eᵢⱼ (column-major order: entry k is the
+    /// derivative along the k-th entry of F's column-major array): the columns of the
+    /// 9 × 9 matrix ∂P/∂F. The work shared between directions (a polar decomposition, a
+    /// cofactor) is done once.
+    #[must_use]
+    pub fn differentials(self, f: Mat3, lame: Lame) -> [Mat3; 9] {
+        let unit = |k: usize| {
+            let mut e = [0.0f32; 9];
+            e[k] = 1.0;
+            Mat3::from_cols_array(&e)
+        };
+        let Lame { mu, lambda } = lame;
+        match self {
+            StrainModel::Corotated => {
+                let (r, s) = polar_decomposition(f);
+                let e = trace(s) - 3.0;
+                std::array::from_fn(|k| {
+                    let df = unit(k);
+                    let dr = rotation_differential(r, s, df);
+                    2.0 * mu * df
+                        + lambda * trace(r.transpose() * df) * r
+                        + (lambda * e - 2.0 * mu) * dr
+                })
+            }
+            StrainModel::StableNeoHookean => {
+                let l = lambda + mu;
+                let j = f.determinant();
+                let c = cofactor(f);
+                std::array::from_fn(|k| {
+                    let df = unit(k);
+                    mu * df
+                        + l * ddot(c, df) * c
+                        + (l * (j - 1.0) - mu) * cofactor_differential(f, df)
+                })
+            }
+            StrainModel::Green => {
+                let stress = linear_stress(green_strain(f), lame);
+                std::array::from_fn(|k| {
+                    let df = unit(k);
+                    let de = 0.5 * (df.transpose() * f + f.transpose() * df);
+                    df * stress + f * linear_stress(de, lame)
+                })
+            }
+            StrainModel::Cauchy => std::array::from_fn(|k| self.differential(f, unit(k), lame)),
+        }
+    }
+}
+
 /// dR for F = R S moved by dF: RᵀdR = [ω]× with (tr S · I − S) ω = axial(RᵀdF − dFᵀR), from
 /// the skew part of RᵀdF = [ω]× S + dS. Where two singular values sum to zero (a flat
 /// element flipping) the system is singular; ω is then taken from its regular part.
