@@ -211,77 +211,71 @@ impl StrainModel {
     /// dP[dF] = (∂P/∂F) : dF (Pa), the stress differential along dF.
     #[must_use]
     pub fn differential(self, f: Mat3, df: Mat3, lame: Lame) -> Mat3 {
-        let Lame { mu, lambda } = lame;
-        match self {
-            StrainModel::Green => {
-                let e = green_strain(f);
-                let de = 0.5 * (df.transpose() * f + f.transpose() * df);
-                df * linear_stress(e, lame) + f * linear_stress(de, lame)
-            }
-            StrainModel::Cauchy => lambda * trace(df) * Mat3::IDENTITY + mu * (df + df.transpose()),
-            StrainModel::Corotated => {
-                let (r, s) = polar_decomposition(f);
-                let dr = rotation_differential(r, s, df);
-                let e = trace(s) - 3.0;
-                2.0 * mu * df
-                    + lambda * trace(r.transpose() * df) * r
-                    + (lambda * e - 2.0 * mu) * dr
-            }
-            StrainModel::StableNeoHookean => {
-                let l = lambda + mu;
-                let j = f.determinant();
-                let c = cofactor(f);
-                mu * df + l * ddot(c, df) * c + (l * (j - 1.0) - mu) * cofactor_differential(f, df)
-            }
-        }
+        Prepared::new(self, f, lame).differential(df, lame)
     }
-}
 
-impl StrainModel {
     /// dP[Eᵢⱼ] for the nine unit directions Eᵢⱼ (column-major order: entry k is the
     /// derivative along the k-th entry of F's column-major array): the columns of the
     /// 9 × 9 matrix ∂P/∂F. The work shared between directions (a polar decomposition, a
     /// cofactor) is done once.
     #[must_use]
     pub fn differentials(self, f: Mat3, lame: Lame) -> [Mat3; 9] {
-        let unit = |k: usize| {
+        let prepared = Prepared::new(self, f, lame);
+        std::array::from_fn(|k| {
             let mut e = [0.0f32; 9];
             e[k] = 1.0;
-            Mat3::from_cols_array(&e)
-        };
-        let Lame { mu, lambda } = lame;
-        match self {
+            prepared.differential(Mat3::from_cols_array(&e), lame)
+        })
+    }
+}
+
+/// What a model's stress differential needs of F, computed once per F.
+enum Prepared {
+    Green { f: Mat3, stress: Mat3 },
+    Cauchy,
+    Corotated { r: Mat3, s: Mat3 },
+    StableNeoHookean { f: Mat3, j: f32, cofactor: Mat3 },
+}
+
+impl Prepared {
+    fn new(model: StrainModel, f: Mat3, lame: Lame) -> Self {
+        match model {
+            StrainModel::Green => Prepared::Green {
+                f,
+                stress: linear_stress(green_strain(f), lame),
+            },
+            StrainModel::Cauchy => Prepared::Cauchy,
             StrainModel::Corotated => {
                 let (r, s) = polar_decomposition(f);
+                Prepared::Corotated { r, s }
+            }
+            StrainModel::StableNeoHookean => Prepared::StableNeoHookean {
+                f,
+                j: f.determinant(),
+                cofactor: cofactor(f),
+            },
+        }
+    }
+
+    fn differential(&self, df: Mat3, lame: Lame) -> Mat3 {
+        let Lame { mu, lambda } = lame;
+        match *self {
+            Prepared::Green { f, stress } => {
+                let de = 0.5 * (df.transpose() * f + f.transpose() * df);
+                df * stress + f * linear_stress(de, lame)
+            }
+            Prepared::Cauchy => lambda * trace(df) * Mat3::IDENTITY + mu * (df + df.transpose()),
+            Prepared::Corotated { r, s } => {
+                let dr = rotation_differential(r, s, df);
                 let e = trace(s) - 3.0;
-                std::array::from_fn(|k| {
-                    let df = unit(k);
-                    let dr = rotation_differential(r, s, df);
-                    2.0 * mu * df
-                        + lambda * trace(r.transpose() * df) * r
-                        + (lambda * e - 2.0 * mu) * dr
-                })
+                2.0 * mu * df
+                    + lambda * trace(r.transpose() * df) * r
+                    + (lambda * e - 2.0 * mu) * dr
             }
-            StrainModel::StableNeoHookean => {
+            Prepared::StableNeoHookean { f, j, cofactor: c } => {
                 let l = lambda + mu;
-                let j = f.determinant();
-                let c = cofactor(f);
-                std::array::from_fn(|k| {
-                    let df = unit(k);
-                    mu * df
-                        + l * ddot(c, df) * c
-                        + (l * (j - 1.0) - mu) * cofactor_differential(f, df)
-                })
+                mu * df + l * ddot(c, df) * c + (l * (j - 1.0) - mu) * cofactor_differential(f, df)
             }
-            StrainModel::Green => {
-                let stress = linear_stress(green_strain(f), lame);
-                std::array::from_fn(|k| {
-                    let df = unit(k);
-                    let de = 0.5 * (df.transpose() * f + f.transpose() * df);
-                    df * stress + f * linear_stress(de, lame)
-                })
-            }
-            StrainModel::Cauchy => std::array::from_fn(|k| self.differential(f, unit(k), lame)),
         }
     }
 }
