@@ -60,6 +60,8 @@ pub(crate) struct Scratch {
     raw: Vec<[f64; 81]>,
     hess: Vec<[f64; 81]>,
     hess0: Vec<[f64; 81]>,
+    /// Per node, the normal of a contact holding it (zero for none).
+    filter: Vec<DVec3>,
     /// Whether any element needed projecting this iteration.
     indefinite: bool,
 }
@@ -249,6 +251,8 @@ pub(crate) fn step(
         s.y[i] = n.x[i] + h * n.v[i];
     }
     // The inertial predictor is the first iterate; pinned nodes stay there.
+    // Contacts found at the end of the last substep: planes n·x ≥ d the nodes may not cross.
+    clamp_to_contacts(&body.contacts, &mut s.y);
     n.x.copy_from_slice(&s.y);
     let free: Vec<bool> = n.inv_mass.iter().map(|&w| w != 0.0).collect();
     let inv_h2 = 1.0 / (hd * hd);
@@ -298,6 +302,21 @@ pub(crate) fn step(
                 }
             }
             (s.d, s.kd) = (d, kd);
+        }
+        // A node on its contact plane that the gradient pushes in is held there: the
+        // contact takes the normal part (Baraff and Witkin's filter). One pulled away is free.
+        s.filter.clear();
+        s.filter.resize(len, DVec3::ZERO);
+        for c in &body.contacts {
+            let i = c.node as usize;
+            let normal = c.normal.as_dvec3();
+            let on_plane =
+                f64::from(c.normal.dot(Vec3::from(n.x[i]))) <= f64::from(c.offset) + 1e-6;
+            if on_plane && s.g[i].dot(normal) > 0.0 {
+                s.filter[i] = normal;
+                let gn = s.g[i].dot(normal);
+                s.g[i] -= gn * normal;
+            }
         }
         let gnorm = dot(&s.g, &s.g).sqrt();
         if !gnorm.is_finite() {
@@ -375,6 +394,7 @@ pub(crate) fn step(
         if !accepted {
             break;
         }
+        clamp_to_contacts(&body.contacts, &mut s.trial);
         n.x.copy_from_slice(&s.trial);
     }
     for i in 0..len {
@@ -415,7 +435,7 @@ fn conjugate_gradients(
     for i in 0..len {
         s.dx[i] = DVec3::ZERO;
         s.r[i] = -s.g[i];
-        s.z[i] = precondition(s.r[i], s.diag[i]);
+        s.z[i] = filtered(precondition(s.r[i], s.diag[i]), s.filter[i]);
     }
     s.p.copy_from_slice(&s.z);
     let mut rz = dot(&s.r, &s.z);
@@ -432,6 +452,7 @@ fn conjugate_gradients(
             if !free[i] {
                 s.q[i] = DVec3::ZERO;
             }
+            s.q[i] = filtered(s.q[i], s.filter[i]);
         }
         let pq = dot(&s.p, &s.q);
         report.cg_iterations += 1;
@@ -447,7 +468,7 @@ fn conjugate_gradients(
             break;
         }
         for i in 0..len {
-            s.z[i] = precondition(s.r[i], s.diag[i]);
+            s.z[i] = filtered(precondition(s.r[i], s.diag[i]), s.filter[i]);
         }
         let rz_new = dot(&s.r, &s.z);
         let b = rz_new / rz;
@@ -457,4 +478,20 @@ fn conjugate_gradients(
         }
     }
     true
+}
+
+/// v without its part along the unit normal `n` (v itself for a zero n).
+fn filtered(v: DVec3, n: DVec3) -> DVec3 {
+    v - v.dot(n) * n
+}
+
+/// Moves every contact node that crossed its plane back onto it.
+fn clamp_to_contacts(contacts: &[super::NodeContact], x: &mut [Vec3A]) {
+    for c in contacts {
+        let i = c.node as usize;
+        let gap = c.normal.dot(Vec3::from(x[i])) - c.offset;
+        if gap < 0.0 {
+            x[i] -= Vec3A::from(gap * c.normal);
+        }
+    }
 }

@@ -29,6 +29,7 @@
 //! Eberle's course notes (2020), without the −½ μ log(I_C + 1) term, with λ′ = λ + μ so that
 //! small strains match linear elasticity. Units: Pa for E, μ, λ, P; J/m³ for Ψ.
 
+mod contact;
 mod implicit;
 pub mod mesh;
 mod plugin;
@@ -165,6 +166,17 @@ pub struct SoftBody {
     lame: Lame,
     model: StrainModel,
     stats: SoftBodyStats,
+    contact_thickness: f32,
+    /// The contacts of the last substep, for the implicit solve to respect.
+    contacts: Vec<NodeContact>,
+}
+
+/// A node held outside a collider: the plane n·x ≥ d at the node's contact.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct NodeContact {
+    node: u32,
+    normal: Vec3,
+    offset: f32,
 }
 
 impl SoftBody {
@@ -205,8 +217,19 @@ impl SoftBody {
             lame: material.lame(),
             model,
             stats: SoftBodyStats::default(),
+            contact_thickness: 0.005,
+            contacts: Vec::new(),
         };
         Ok((nodes, body))
+    }
+
+    /// How far from a collider's surface its nodes are kept (m; default 5 mm).
+    ///
+    /// # Errors
+    /// [`Error::Negative`] / [`Error::NonFinite`].
+    pub fn with_contact_thickness(mut self, metres: f32) -> Result<Self> {
+        self.contact_thickness = non_negative("contact thickness", metres)?;
+        Ok(self)
     }
 
     /// The tetrahedra (indices into the nodes).

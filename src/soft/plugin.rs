@@ -9,7 +9,7 @@ use crate::integrator::ImplicitEuler;
 use crate::particles::Nodes;
 use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::schedule::{
-    FinishSystems, ForceSystems, IntegrationSystems, PhysicsSchedule, SubstepSchedule,
+    FinishSystems, ForceSystems, IntegrationSystems, PhysicsSchedule, StepSystems, SubstepSchedule,
     add_force_systems, add_systems,
 };
 use crate::time::SubstepTime;
@@ -31,6 +31,14 @@ impl WorldPlugin for SoftBodyPlugin {
             solve_implicit
                 .run_if(any_with_component::<ImplicitEuler>)
                 .in_set(IntegrationSystems::Integrate),
+        );
+        add_systems(
+            world,
+            SubstepSchedule,
+            super::contact::collide_nodes
+                .run_if(any_with_component::<SoftBody>)
+                .run_if(any_with_component::<crate::collision::Collider>)
+                .in_set(StepSystems::RelaxConstraints),
         );
         add_systems(
             world,
