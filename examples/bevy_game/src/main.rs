@@ -6,7 +6,7 @@
 //! - **Arrow keys**: orbit the camera.
 //!
 //! ```sh
-//! cargo run --release --manifest-path examples/bevy_game/Cargo.toml
+//! cargo run --release --manifest-path examples/bevy_game/Cargo.toml   # add --ignore-rust-version on Rust < 1.97.1
 //! ```
 
 use bevy::prelude::*;
@@ -89,7 +89,9 @@ fn setup(
     ));
     commands.spawn((Camera3d::default(), Transform::default()));
     commands.spawn((
-        Text::new("left click: throw at the cursor · space: throw · R: rebuild · arrows: orbit"),
+        Text::new(
+            "left click: throw at the cursor  |  space: throw  |  R: rebuild  |  arrows: orbit",
+        ),
         Node {
             position_type: PositionType::Absolute,
             top: px(8),
