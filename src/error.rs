@@ -36,6 +36,16 @@ pub enum Error {
         /// The rejected value.
         value: f32,
     },
+    /// A mesh file could not be read or is malformed.
+    #[error("{file}:{line}: {message}")]
+    MeshFile {
+        /// The file (or `.node`, `.ele`, `.msh` for text given directly).
+        file: String,
+        /// The 1-based line (0 when the file could not be read at all).
+        line: usize,
+        /// What is wrong.
+        message: String,
+    },
     /// A tetrahedron of a mesh has repeated corners or (almost) no volume.
     #[error("tetrahedron {index} is degenerate (rest volume {volume} m³)")]
     DegenerateElement {

@@ -402,6 +402,7 @@ fn main() {
     }
     if run("soft") {
         soft::soft_lines(&cfg);
+        soft::cantilever_vs_rapier(&cfg);
     }
     #[cfg(feature = "bevy")]
     if run("bevy") {

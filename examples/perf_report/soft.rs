@@ -171,3 +171,110 @@ pub fn soft_lines(cfg: &Config) {
         "no soft body in the world; goal <= 1.03",
     );
 }
+
+/// rapier 0.36's own cantilever (`examples/fem_bench.rs`): a 2 m × 0.2 m × 0.2 m bar, E = 1.2e7,
+/// ν = 0, 8 kg, fixed at x = 0, under its own weight; Euler–Bernoulli's tip deflection
+/// q L⁴ / (8 E I) = 0.0491 m. Both engines mesh `nodes` grid points (five tets per cell, as
+/// rapier does), dt = 1/60, one substep; each figure is the mean tip height after 1500 steps.
+pub fn cantilever_vs_rapier(cfg: &Config) {
+    use rapier3d::prelude as rp;
+    let (length, side, young) = (2.0f32, 0.2f32, 1.2e7f32);
+    let exact = 8.0 * 9.81 / length * length.powi(4) / (8.0 * young * side.powi(4) / 12.0);
+    for nodes in [[9usize, 3, 3], [17, 5, 5]] {
+        let cells = [nodes[0] - 1, nodes[1] - 1, nodes[2] - 1];
+        // hooke
+        let mut w = scenes::world_with(
+            1.0 / 60.0,
+            1,
+            Integrator::SymplecticEuler,
+            Vec3::new(0.0, -9.81, 0.0),
+        )
+        .unwrap();
+        w.resource_mut::<DiagnosticsSettings>().energy = false;
+        let mesh = TetMesh::cuboid(Vec3::new(length, side, side), cells, CellSplit::Five).unwrap();
+        let volume = length * side * side;
+        let material = Material::new(young, 0.0, 8.0 / volume).unwrap();
+        let (mut n, b) = SoftBody::build(
+            &mesh,
+            Vec3::new(0.5 * length, 0.0, 0.0),
+            material,
+            StrainModel::Corotated,
+        )
+        .unwrap();
+        let tip: Vec<usize> = (0..n.len())
+            .filter(|&i| n.positions()[i].x > length - 1e-4)
+            .collect();
+        for i in 0..n.len() {
+            if n.positions()[i].x < 1e-4 {
+                n.pin(i).unwrap();
+            }
+        }
+        let e = w.spawn((n, b, ImplicitEuler::default())).id();
+        // rapier
+        let mut r = rp::PhysicsWorld::new();
+        r.integration_parameters.num_solver_iterations = 1;
+        let half = rp::Vector::new(0.5 * length, 0.5 * side, 0.5 * side);
+        let builder = rp::SoftBodyBuilder::cuboid(
+            rp::Vector::new(0.5 * length, 0.0, 0.0),
+            half,
+            nodes[0],
+            nodes[1],
+            nodes[2],
+        )
+        .cell_model(rp::SoftBodyCellModel::Corotational)
+        .material(rp::SoftBodyMaterial {
+            young_modulus: young,
+            poisson_ratio: 0.0,
+            elastic_damping_ratio: 1.0,
+            ..Default::default()
+        })
+        .solver(rp::SoftBodySolver::Fem)
+        .mass(8.0)
+        .no_surface_collider()
+        .can_sleep(false);
+        let pinned: Vec<u32> = builder
+            .particle_positions()
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.x < 1e-4)
+            .map(|(i, _)| i as u32)
+            .collect();
+        let rtip: Vec<usize> = builder
+            .particle_positions()
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| p.x > length - 1e-4)
+            .map(|(i, _)| i)
+            .collect();
+        let handle = r.insert_soft_body(builder.pinned_particles(pinned));
+        for _ in 0..1500 {
+            w.step_physics();
+            r.step();
+        }
+        let ours_y = {
+            let n = w.get::<Nodes>(e).unwrap();
+            tip.iter().map(|&i| n.positions()[i].y).sum::<f32>() / tip.len() as f32
+        };
+        let theirs_y = {
+            let sb = &r.soft_bodies[handle];
+            rtip.iter().map(|&i| sb.particle_position(i).y).sum::<f32>() / rtip.len() as f32
+        };
+        let (t_ours, t_theirs) = compare(cfg, || w.step_physics(), || r.step());
+        line(
+            &format!(
+                "cantilever_{}x{}x{}_vs_rapier_fem",
+                nodes[0], nodes[1], nodes[2]
+            ),
+            t_ours,
+            t_theirs,
+            &format!(
+                "{} tets; tip deflection hooke {:.4} m ({:+.1}%), rapier {:.4} m ({:+.1}%), beam theory {exact:.4} m",
+                mesh.tets().len(),
+                -ours_y,
+                100.0 * (-ours_y / exact - 1.0),
+                -theirs_y,
+                100.0 * (-theirs_y / exact - 1.0),
+            ),
+        );
+    }
+}

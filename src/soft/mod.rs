@@ -31,6 +31,7 @@
 
 mod contact;
 mod implicit;
+mod io;
 pub mod mesh;
 mod plugin;
 pub mod strain;
