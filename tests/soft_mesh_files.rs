@@ -23,7 +23,10 @@ fn tetgen_files_are_read() {
         assert_eq!(TetMesh::load_tetgen(dir.join(p)).unwrap(), m);
     }
     let missing = TetMesh::load_tetgen(dir.join("nothing")).unwrap_err();
-    assert!(matches!(missing, Error::MeshFile { line: 0, .. }), "{missing}");
+    assert!(
+        matches!(missing, Error::MeshFile { line: 0, .. }),
+        "{missing}"
+    );
 }
 
 fn line_of(e: Error) -> (usize, String) {
@@ -48,14 +51,24 @@ fn bad_tetgen_files_say_where() {
     let (line, msg) = line_of(TetMesh::from_tetgen(NODE, &flat).unwrap_err());
     assert_eq!(line, 6, "{msg}");
     let short = "8 3 0 1\n1 0 0 0\n";
-    assert!(line_of(TetMesh::from_tetgen(short, ELE).unwrap_err()).1.contains("ends"));
+    assert!(
+        line_of(TetMesh::from_tetgen(short, ELE).unwrap_err())
+            .1
+            .contains("ends")
+    );
     let two_d = "8 2 0 0\n";
-    assert!(line_of(TetMesh::from_tetgen(two_d, ELE).unwrap_err()).1.contains("dimension"));
+    assert!(
+        line_of(TetMesh::from_tetgen(two_d, ELE).unwrap_err())
+            .1
+            .contains("dimension")
+    );
 }
 
 /// A mesh written as Gmsh 2.2 ASCII, with a triangle (type 2) the reader must skip.
 fn gmsh2(m: &TetMesh) -> String {
-    let mut s = String::from("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n3 1 \"body\"\n$EndPhysicalNames\n$Nodes\n");
+    let mut s = String::from(
+        "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$PhysicalNames\n1\n3 1 \"body\"\n$EndPhysicalNames\n$Nodes\n",
+    );
     s += &format!("{}\n", m.points().len());
     for (i, p) in m.points().iter().enumerate() {
         s += &format!("{} {} {} {}\n", i + 1, p.x, p.y, p.z);
@@ -63,7 +76,14 @@ fn gmsh2(m: &TetMesh) -> String {
     s += &format!("$EndNodes\n$Elements\n{}\n", m.tets().len() + 1);
     s += "1 2 2 0 1 1 2 3\n";
     for (k, t) in m.tets().iter().enumerate() {
-        s += &format!("{} 4 2 1 1 {} {} {} {}\n", k + 2, t[0] + 1, t[1] + 1, t[2] + 1, t[3] + 1);
+        s += &format!(
+            "{} 4 2 1 1 {} {} {} {}\n",
+            k + 2,
+            t[0] + 1,
+            t[1] + 1,
+            t[2] + 1,
+            t[3] + 1
+        );
     }
     s + "$EndElements\n"
 }
@@ -71,7 +91,9 @@ fn gmsh2(m: &TetMesh) -> String {
 /// The same as Gmsh 4.1 ASCII: nodes and elements in entity blocks, tags offset by 100.
 fn gmsh4(m: &TetMesh) -> String {
     let n = m.points().len();
-    let mut s = String::from("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1 0 0 0 1 1 1 0 0\n$EndEntities\n$Nodes\n");
+    let mut s = String::from(
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Entities\n0 0 0 1\n1 0 0 0 1 1 1 0 0\n$EndEntities\n$Nodes\n",
+    );
     s += &format!("1 {n} 101 {}\n3 1 0 {n}\n", 100 + n);
     for i in 0..n {
         s += &format!("{}\n", 101 + i);
@@ -79,9 +101,19 @@ fn gmsh4(m: &TetMesh) -> String {
     for p in m.points() {
         s += &format!("{} {} {}\n", p.x, p.y, p.z);
     }
-    s += &format!("$EndNodes\n$Elements\n1 {0} 1 {0}\n3 1 4 {0}\n", m.tets().len());
+    s += &format!(
+        "$EndNodes\n$Elements\n1 {0} 1 {0}\n3 1 4 {0}\n",
+        m.tets().len()
+    );
     for (k, t) in m.tets().iter().enumerate() {
-        s += &format!("{} {} {} {} {}\n", k + 1, t[0] + 101, t[1] + 101, t[2] + 101, t[3] + 101);
+        s += &format!(
+            "{} {} {} {} {}\n",
+            k + 1,
+            t[0] + 101,
+            t[1] + 101,
+            t[2] + 101,
+            t[3] + 101
+        );
     }
     s + "$EndElements\n"
 }
@@ -109,14 +141,29 @@ fn bad_gmsh_files_say_where() {
     let binary = good.replace("2.2 0 8", "2.2 1 8");
     assert_eq!(line_of(TetMesh::from_gmsh(&binary).unwrap_err()).0, 2);
     let v3 = good.replace("2.2 0 8", "3.0 0 8");
-    assert!(line_of(TetMesh::from_gmsh(&v3).unwrap_err()).1.contains("format"));
+    assert!(
+        line_of(TetMesh::from_gmsh(&v3).unwrap_err())
+            .1
+            .contains("format")
+    );
     let unknown_node = good.replace("3 4 2 1 1 ", "3 4 2 1 1 99 ");
     let (line, msg) = line_of(TetMesh::from_gmsh(&unknown_node).unwrap_err());
     assert!(msg.contains("corner 99"), "{msg}");
-    assert_eq!(good.lines().nth(line - 1).map(|l| l.starts_with("3 4")), Some(true));
+    assert_eq!(
+        good.lines().nth(line - 1).map(|l| l.starts_with("3 4")),
+        Some(true)
+    );
     let truncated: String = good.lines().take(14).map(|l| format!("{l}\n")).collect();
-    assert!(line_of(TetMesh::from_gmsh(&truncated).unwrap_err()).1.contains("ends"));
-    assert!(line_of(TetMesh::from_gmsh("hello\n").unwrap_err()).1.contains("not a Gmsh"));
+    assert!(
+        line_of(TetMesh::from_gmsh(&truncated).unwrap_err())
+            .1
+            .contains("ends")
+    );
+    assert!(
+        line_of(TetMesh::from_gmsh("hello\n").unwrap_err())
+            .1
+            .contains("not a Gmsh")
+    );
     let missing = TetMesh::load_gmsh("/nonexistent/mesh.msh").unwrap_err();
     assert!(matches!(missing, Error::MeshFile { line: 0, .. }));
 }

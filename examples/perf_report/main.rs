@@ -402,7 +402,7 @@ fn main() {
     }
     if run("soft") {
         soft::soft_lines(&cfg);
-        soft::cantilever_vs_rapier(&cfg);
+        soft::cantilever_vs_rapier(&cfg, if quick { 150 } else { 1500 });
     }
     #[cfg(feature = "bevy")]
     if run("bevy") {

@@ -175,8 +175,8 @@ pub fn soft_lines(cfg: &Config) {
 /// rapier 0.36's own cantilever (`examples/fem_bench.rs`): a 2 m × 0.2 m × 0.2 m bar, E = 1.2e7,
 /// ν = 0, 8 kg, fixed at x = 0, under its own weight; Euler–Bernoulli's tip deflection
 /// q L⁴ / (8 E I) = 0.0491 m. Both engines mesh `nodes` grid points (five tets per cell, as
-/// rapier does), dt = 1/60, one substep; each figure is the mean tip height after 1500 steps.
-pub fn cantilever_vs_rapier(cfg: &Config) {
+/// rapier does), dt = 1/60, one substep; each figure is the mean tip height after `steps` steps (1500 in rapier's bench).
+pub fn cantilever_vs_rapier(cfg: &Config, steps: usize) {
     use rapier3d::prelude as rp;
     let (length, side, young) = (2.0f32, 0.2f32, 1.2e7f32);
     let exact = 8.0 * 9.81 / length * length.powi(4) / (8.0 * young * side.powi(4) / 12.0);
@@ -247,7 +247,7 @@ pub fn cantilever_vs_rapier(cfg: &Config) {
             .map(|(i, _)| i)
             .collect();
         let handle = r.insert_soft_body(builder.pinned_particles(pinned));
-        for _ in 0..1500 {
+        for _ in 0..steps {
             w.step_physics();
             r.step();
         }
@@ -259,6 +259,7 @@ pub fn cantilever_vs_rapier(cfg: &Config) {
             let sb = &r.soft_bodies[handle];
             rtip.iter().map(|&i| sb.particle_position(i).y).sum::<f32>() / rtip.len() as f32
         };
+        let solve = w.get::<SoftBody>(e).unwrap().stats().implicit;
         let (t_ours, t_theirs) = compare(cfg, || w.step_physics(), || r.step());
         line(
             &format!(
@@ -268,10 +269,12 @@ pub fn cantilever_vs_rapier(cfg: &Config) {
             t_ours,
             t_theirs,
             &format!(
-                "{} tets; tip deflection hooke {:.4} m ({:+.1}%), rapier {:.4} m ({:+.1}%), beam theory {exact:.4} m",
+                "{} tets; tip deflection hooke {:.4} m ({:+.1}%; {} Newton, {} CG per step), rapier {:.4} m ({:+.1}%), beam theory {exact:.4} m",
                 mesh.tets().len(),
                 -ours_y,
                 100.0 * (-ours_y / exact - 1.0),
+                solve.newton_iterations,
+                solve.cg_iterations,
                 -theirs_y,
                 100.0 * (-theirs_y / exact - 1.0),
             ),

@@ -121,9 +121,10 @@ impl Integrator {
 /// forces of the step (gravity, external, damping) enter as f_ext.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
 pub struct ImplicitEuler {
-    /// Newton stops when the gradient's norm has fallen below this fraction of its first
-    /// value (dimensionless; default 1e-3), or when it stalls at the floor that f32
-    /// positions set (about 1e-4 of the first gradient on a stiff body).
+    /// Newton stops when the gradient's norm has fallen below this fraction of the step's
+    /// force scale — its first gradient, or for a body at rest its weight and momentum over
+    /// h (dimensionless; default 1e-3) — or when it stalls at the floor that f32 positions set
+    /// (about 1e-4 of that scale on a stiff body).
     pub tolerance: f32,
     /// Newton iterations per substep at most (default 8).
     pub max_newton: u32,
