@@ -9,10 +9,11 @@
 //! cargo run --release --manifest-path examples/bevy_game/Cargo.toml   # add --ignore-rust-version on Rust < 1.97.1
 //! ```
 
+// Both preludes glob-imported, warnings denied: hooke's names must not clash with Bevy's.
+#![deny(warnings)]
+
 use bevy::prelude::*;
-use hooke::prelude::{
-    Collider, ColliderDensity, LinearVelocity, PhysicsPlugins, RigidBody, TransformInterpolation,
-};
+use hooke::prelude::*;
 
 /// Half extent of a crate (m).
 const HALF: f32 = 0.25;
