@@ -48,6 +48,7 @@ mod solver;
 pub use attach::{ColliderDensity, ColliderOf, ColliderOffset};
 pub use narrow::{ContactPair, Contacts};
 pub use plugin::CollisionPlugin;
+pub(crate) use plugin::shape_pose;
 pub use query::{Hit, Projection, QueryFilter, SpatialQuery};
 
 use bevy_ecs::prelude::*;

@@ -114,7 +114,7 @@ fn part_pose(shape: &Pose, part: Option<&Pose>) -> Pose {
 }
 
 /// The pose of a collider's shape frame: origin x − R c.
-fn shape_pose(x: Vec3A, q: Quat, com: Option<&CenterOfMass>) -> Pose {
+pub(crate) fn shape_pose(x: Vec3A, q: Quat, com: Option<&CenterOfMass>) -> Pose {
     let c = com.map_or(Vec3::ZERO, |c| c.0);
     Pose::from_parts(Vec3::from(x) - q * c, q)
 }

@@ -45,8 +45,7 @@ pub(crate) fn collide_nodes(
             if aabb.min.cmpgt(hi).any() || aabb.max.cmplt(lo).any() {
                 continue;
             }
-            let com = com.map_or(Vec3::ZERO, |c| c.0);
-            let pose = Pose::from_parts(Vec3::from(x.0) - q.0 * com, q.0);
+            let pose = crate::collision::shape_pose(x.0, q.0, com);
             push_out(
                 n,
                 &mut body.contacts,

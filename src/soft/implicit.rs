@@ -60,6 +60,8 @@ pub(crate) struct Scratch {
     raw: Vec<[f64; 81]>,
     hess: Vec<[f64; 81]>,
     hess0: Vec<[f64; 81]>,
+    /// Per node, whether it moves (not pinned).
+    free: Vec<bool>,
     /// Per node, the normal of a contact holding it (zero for none).
     filter: Vec<DVec3>,
     /// Whether any element needed projecting this iteration.
@@ -260,7 +262,9 @@ pub(crate) fn step(
     // Contacts found at the end of the last substep: planes n·x ≥ d the nodes may not cross.
     clamp_to_contacts(&body.contacts, &mut s.y);
     n.x.copy_from_slice(&s.y);
-    let free: Vec<bool> = n.inv_mass.iter().map(|&w| w != 0.0).collect();
+    let mut free = std::mem::take(&mut s.free);
+    free.clear();
+    free.extend(n.inv_mass.iter().map(|&w| w != 0.0));
     let inv_h2 = 1.0 / (hd * hd);
     let mut report = ImplicitReport::default();
     let (mut g0, mut previous) = (0.0f64, f64::INFINITY);
@@ -417,13 +421,14 @@ pub(crate) fn step(
     for i in 0..len {
         n.v[i] = (n.x[i] - s.x0[i]) / h;
     }
+    s.free = free;
     // Stats at the end state.
     let x_end = n.x.clone();
     let ok = elastic_forces(body, n, &x_end, s);
     (ok && n.x.iter().all(|x| x.is_finite())).then_some(report)
 }
 
-/// CG on H dx = −g with the element matrices `hess` (and D from `s.hess0`); false if it met
+/// CG on H dx = −g with the element matrices `hess` (and D from `s.hess0`, K₀'s); false if it met
 /// negative curvature.
 #[allow(clippy::too_many_arguments)] // the solve's whole state, passed once per Newton step
 fn conjugate_gradients(
