@@ -283,3 +283,76 @@ fn a_stiff_jelly_cube_lands_and_rests_at_60_hz_with_one_implicit_substep() {
     // layer, which the implicit solve avoids by holding contact nodes in the solve.)
     assert_eq!(needed, Some(32));
 }
+
+#[test]
+fn targeted_nodes_carry_the_body_and_let_go() {
+    use hooke::soft::NodeTargets;
+    for implicit in [true, false] {
+        let substeps = if implicit { 1 } else { 16 };
+        let mut w = world(Vec3::new(0.0, -9.81, 0.0), 1.0 / 60.0, substeps);
+        let material = Material::new(2e4, 0.3, 500.0).unwrap();
+        let mesh = TetMesh::cuboid(Vec3::new(0.4, 0.1, 0.1), [4, 1, 1], CellSplit::Six).unwrap();
+        let (nodes, body) = SoftBody::build(
+            &mesh,
+            Vec3::new(0.2, 1.0, 0.0),
+            material,
+            StrainModel::Corotated,
+        )
+        .unwrap();
+        let grip: Vec<usize> = (0..nodes.len())
+            .filter(|&i| nodes.positions()[i].x.abs() < 1e-5)
+            .collect();
+        let start: Vec<Vec3> = grip
+            .iter()
+            .map(|&i| Vec3::from(nodes.positions()[i]))
+            .collect();
+        let targets = NodeTargets::new(grip.iter().copied().zip(start.iter().copied())).unwrap();
+        let e = if implicit {
+            w.spawn((nodes, body, targets, ImplicitEuler::default()))
+                .id()
+        } else {
+            w.spawn((nodes, body, targets)).id()
+        };
+        // Carry the grip 1 m along x in 1 s.
+        for step in 1..=60 {
+            let shift = Vec3::X * (step as f32 / 60.0);
+            let mut t = w.get_mut::<NodeTargets>(e).unwrap();
+            for (&i, p) in grip.iter().zip(&start) {
+                t.set(i, *p + shift).unwrap();
+            }
+            w.step_physics();
+        }
+        let n = w.get::<Nodes>(e).unwrap();
+        for (&i, p) in grip.iter().zip(&start) {
+            let x = Vec3::from(n.positions()[i]);
+            assert!(
+                (x - (*p + Vec3::X)).length() < 1e-4,
+                "implicit {implicit}: grip at {x}"
+            );
+        }
+        let far = n.positions().iter().map(|p| p.x).fold(f32::MIN, f32::max);
+        assert!(
+            far > 1.2,
+            "implicit {implicit}: the body came along ({far})"
+        );
+        // Let go: the grip gets its mass back and everything falls.
+        w.entity_mut(e).remove::<NodeTargets>();
+        assert!(
+            w.get::<Nodes>(e)
+                .unwrap()
+                .mass(grip[0])
+                .unwrap()
+                .is_finite()
+        );
+        let y0 = w.get::<Nodes>(e).unwrap().positions()[grip[0]].y;
+        for _ in 0..30 {
+            w.step_physics();
+        }
+        let y1 = w.get::<Nodes>(e).unwrap().positions()[grip[0]].y;
+        assert!(
+            y1 < y0 - 0.5,
+            "implicit {implicit}: released grip falls ({y0} -> {y1})"
+        );
+        assert!(w.get::<Quarantined>(e).is_none());
+    }
+}

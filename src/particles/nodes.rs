@@ -98,6 +98,18 @@ impl Nodes {
         Ok(())
     }
 
+    /// Gives node `i` the mass `kg` (unpinning a pinned node).
+    ///
+    /// # Errors
+    /// [`Error::IndexOutOfRange`] or [`Error::InvalidMass`].
+    pub fn set_mass(&mut self, i: usize, kg: f32) -> Result<()> {
+        self.check(i)?;
+        let m = crate::Mass::new(kg)?;
+        self.mass[i] = m.force_scale();
+        self.inv_mass[i] = m.inverse();
+        Ok(())
+    }
+
     /// Moves node `i` to `x` (m).
     ///
     /// # Errors

@@ -35,11 +35,13 @@ mod io;
 pub mod mesh;
 mod plugin;
 pub mod strain;
+mod targets;
 
 pub use implicit::ImplicitReport;
 pub use mesh::{CellSplit, TetMesh};
 pub use plugin::SoftBodyPlugin;
 pub use strain::{StrainModel, Stress};
+pub use targets::NodeTargets;
 
 use bevy_ecs::prelude::*;
 use glam::{Mat3, Vec3, Vec3A};

@@ -43,6 +43,13 @@ impl WorldPlugin for SoftBodyPlugin {
         add_systems(
             world,
             PhysicsSchedule,
+            super::targets::drive_node_targets
+                .run_if(any_with_component::<super::NodeTargets>)
+                .in_set(crate::schedule::PrepareSystems::Inputs),
+        );
+        add_systems(
+            world,
+            PhysicsSchedule,
             report_elastic_energy
                 .run_if(any_with_component::<SoftBody>)
                 .in_set(FinishSystems::Writeback),
