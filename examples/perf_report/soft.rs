@@ -281,3 +281,79 @@ pub fn cantilever_vs_rapier(cfg: &Config, steps: usize) {
         );
     }
 }
+
+/// The strain models as a dial: each model's tip deflection on the 1 m cantilever of the
+/// tests (E = 1e8, ν = 0, 10 N, static solve on 30 × 6 × 6 cells) against beam theory, and its
+/// time per 60 Hz implicit step (default settings) of the same bar under gravity, relative
+/// to co-rotated.
+pub fn strain_dial(cfg: &Config) {
+    println!(
+        "\n# strain models: cantilever 1 m × 0.1 m², E = 1e8, 10 N, 6,480 tets; beam theory 4.000 mm"
+    );
+    let exact = 10.0 / (3.0 * 1e8 * (0.1f32.powi(4) / 12.0));
+    let bar = |model: StrainModel, dt: f32, g: Vec3| {
+        let mut w = scenes::world_with(dt, 1, Integrator::SymplecticEuler, g).unwrap();
+        w.resource_mut::<DiagnosticsSettings>().energy = false;
+        let mesh = TetMesh::cuboid(Vec3::new(1.0, 0.1, 0.1), [30, 6, 6], CellSplit::Six).unwrap();
+        let material = Material::new(1e8, 0.0, 1000.0).unwrap();
+        let (mut n, b) = SoftBody::build(&mesh, Vec3::new(0.5, 0.0, 0.0), material, model).unwrap();
+        let tip: Vec<usize> = (0..n.len())
+            .filter(|&i| n.positions()[i].x > 1.0 - 1e-5)
+            .collect();
+        for i in 0..n.len() {
+            if n.positions()[i].x < 1e-5 {
+                n.pin(i).unwrap();
+            }
+        }
+        // The static solve converged hard; the timed 60 Hz steps at the defaults a game uses.
+        let settings = if dt > 1.0 {
+            ImplicitEuler {
+                tolerance: 1e-6,
+                max_newton: 3,
+                max_cg: 5000,
+            }
+        } else {
+            ImplicitEuler::default()
+        };
+        let e = w.spawn((n, b, settings)).id();
+        (w, e, tip)
+    };
+    let timed = |model: StrainModel| {
+        let (w, _, _) = bar(model, 1.0 / 60.0, Vec3::new(0.0, -9.81, 0.0));
+        w
+    };
+    let mut reference = timed(StrainModel::Corotated);
+    for model in StrainModel::ALL {
+        // Static: one step of 100 s with the tip load as an external force on the tip nodes.
+        let (mut w, e, tip) = bar(model, 100.0, Vec3::ZERO);
+        let each = 10.0 / tip.len() as f32;
+        w.insert_resource(Tip(e, tip.clone(), each));
+        hooke::schedule::add_force_systems(&mut w, || tip_load.in_set(hooke::ForceSystems::User));
+        w.step_physics();
+        let n = w.get::<Nodes>(e).unwrap();
+        let d = -tip.iter().map(|&i| n.positions()[i].y).sum::<f32>() / tip.len() as f32;
+        let mut ours = timed(model);
+        let (t, r) = compare(cfg, || ours.step_physics(), || reference.step_physics());
+        line(
+            &format!("dial_cantilever_{}", model.name()),
+            t,
+            r,
+            &format!(
+                "tip {:.4} mm, error {:+.1}% (time relative to co-rotated)",
+                d * 1e3,
+                100.0 * (d / exact - 1.0)
+            ),
+        );
+    }
+}
+
+#[derive(Resource)]
+struct Tip(Entity, Vec<usize>, f32);
+
+fn tip_load(tip: Res<Tip>, mut meshes: Query<&mut Nodes>) {
+    if let Ok(mut n) = meshes.get_mut(tip.0) {
+        for &i in &tip.1 {
+            let _ = n.add_force(i, Vec3A::new(0.0, -tip.2, 0.0));
+        }
+    }
+}
