@@ -13,13 +13,19 @@ fn readme_quick_start_runs() -> Result<(), hooke::Error> {
         .spawn(ParticleBundle::new(Vec3::Y * 10.0, Vec3::ZERO, 1.0)?)
         .id();
     ChainBuilder::rope(Vec3::ZERO, Vec3::X, 20).spawn(&mut world)?;
-    // A rigid box that collides: mass properties from the parry shape at 1000 kg/m³.
-    let shape = Collider::cuboid(0.5, 0.5, 0.5)?;
-    let body = RigidBodyBundle::from_shape(&**shape.shape(), 1000.0)?.at(Vec3::Y * 3.0)?;
-    world.spawn((body, shape));
+    // A rigid box that collides: mass and inertia from the collider at 1000 kg/m³.
+    let crate_ = world
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::cuboid(0.5, 0.5, 0.5)?,
+            Position::from(Vec3::Y * 3.0),
+        ))
+        .id();
     world.advance_physics(frame_seconds)?; // fixed steps through an accumulator
     let y = world.get::<Position>(ball).unwrap().0.y;
     // A frame of 1 s runs only max_steps_per_frame (4) steps of 1/60 s: 1/15 s of fall.
     assert!(y < 10.0 && y > 9.9, "{y}");
+    let box_y = world.get::<Position>(crate_).unwrap().0.y;
+    assert!(box_y < 3.0 && box_y > 2.9, "the box falls too: {box_y}");
     Ok(())
 }
