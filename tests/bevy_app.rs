@@ -65,6 +65,11 @@ fn a_body_spawned_like_avian_falls() {
             Transform::from_xyz(0.0, 5.0, 0.0),
         ),
     );
+    // Placed at spawn, before any fixed step reads the Transform.
+    assert_eq!(
+        app.world().get::<Position>(body).unwrap().get(),
+        Vec3::new(0.0, 5.0, 0.0)
+    );
     frames(&mut app, 61);
     let n = fixed_steps(&app) as f32;
     assert!(n > 60.0, "{n} fixed steps");

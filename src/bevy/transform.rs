@@ -42,6 +42,7 @@ impl Plugin for PhysicsTransformPlugin {
                 write_transforms.in_set(PhysicsAppSystems::Writeback),
             ),
         );
+        app.add_observer(place_on_spawn);
     }
 }
 
@@ -136,6 +137,40 @@ fn read_transforms(
         if !particle {
             cmd.insert(Rotation(rotation));
         }
+    }
+}
+
+/// Observer: a root body or collider spawned with a `Transform` has its physics pose at once,
+/// so game code reading `Position` before the first fixed step sees where it was put.
+fn place_on_spawn(
+    event: On<Insert<Transform>>,
+    mut bodies: Query<
+        (
+            &Transform,
+            &mut Position,
+            Option<&mut Rotation>,
+            Option<&CenterOfMass>,
+        ),
+        (Posed, Without<ChildOf>, Without<SyncedTransform>),
+    >,
+) {
+    let Ok((t, mut x, q, com)) = bodies.get_mut(event.event().entity) else {
+        return;
+    };
+    if *t == Transform::IDENTITY {
+        return;
+    }
+    let c = com.map_or(Vec3::ZERO, |c| c.0);
+    let rotation = match q {
+        Some(mut q) => {
+            q.0 = t.rotation.normalize();
+            q.0
+        }
+        None => Quat::IDENTITY,
+    };
+    let centre = t.translation + rotation * c;
+    if centre.is_finite() {
+        x.0 = centre.into();
     }
 }
 
