@@ -140,19 +140,19 @@ fn read_transforms(
     }
 }
 
+/// What [`place_on_spawn`] reads and writes.
+type SpawnPose<'a> = (
+    &'a Transform,
+    &'a mut Position,
+    Option<&'a mut Rotation>,
+    Option<&'a CenterOfMass>,
+);
+
 /// Observer: a root body or collider spawned with a `Transform` has its physics pose at once,
 /// so game code reading `Position` before the first fixed step sees where it was put.
 fn place_on_spawn(
     event: On<Insert<Transform>>,
-    mut bodies: Query<
-        (
-            &Transform,
-            &mut Position,
-            Option<&mut Rotation>,
-            Option<&CenterOfMass>,
-        ),
-        (Posed, Without<ChildOf>, Without<SyncedTransform>),
-    >,
+    mut bodies: Query<SpawnPose, (Posed, Without<ChildOf>, Without<SyncedTransform>)>,
 ) {
     let Ok((t, mut x, q, com)) = bodies.get_mut(event.event().entity) else {
         return;
