@@ -203,18 +203,12 @@ fn potential(
     e
 }
 
-/// The elastic forces alone (no damping) at `x` into `s.elastic`; false if non-finite.
-fn elastic_forces(body: &mut SoftBody, n: &Nodes, x: &[Vec3A], s: &mut Scratch) -> bool {
+/// The elastic forces alone (no damping) at the nodes' positions into `s.elastic`; false if
+/// non-finite.
+fn elastic_forces(body: &mut SoftBody, n: &Nodes, s: &mut Scratch) -> bool {
     s.elastic.iter_mut().for_each(|f| *f = Vec3A::ZERO);
-    let material = body.material;
-    body.material = super::Material {
-        mass_damping: 0.0,
-        stiffness_damping: 0.0,
-        ..material
-    };
-    let ok = body.accumulate(x, &s.zero, &n.mass, &mut s.elastic);
-    body.material = material;
-    ok
+    // At zero velocity both Rayleigh terms vanish: what is left is the elastic force.
+    body.accumulate(&n.x, &s.zero, &n.mass, &mut s.elastic)
 }
 
 /// One backward-Euler substep of length `h` for `body`'s nodes. `n.f` holds the step's
@@ -282,11 +276,7 @@ pub(crate) fn step(
         if it == 0 {
             s.hess0.clone_from(&s.hess);
         }
-        let x_now = std::mem::take(&mut s.trial);
-        let mut x_now = x_now;
-        x_now.copy_from_slice(&n.x);
-        let ok = elastic_forces(body, n, &x_now, s);
-        s.trial = x_now;
+        let ok = elastic_forces(body, n, s);
         if !ok {
             return None;
         }
@@ -394,8 +384,7 @@ pub(crate) fn step(
         }
 
         // Backtracking line search on E.
-        let x_now = n.x.clone();
-        let e_now = potential(body, n, s, &x_now, hd, alpha, beta);
+        let e_now = potential(body, n, s, &n.x, hd, alpha, beta);
         let slope = dot(&s.g, &s.dx);
         let mut step = 1.0f64;
         let mut accepted = false;
@@ -423,8 +412,7 @@ pub(crate) fn step(
     }
     s.free = free;
     // Stats at the end state.
-    let x_end = n.x.clone();
-    let ok = elastic_forces(body, n, &x_end, s);
+    let ok = elastic_forces(body, n, s);
     (ok && n.x.iter().all(|x| x.is_finite())).then_some(report)
 }
 
