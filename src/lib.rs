@@ -168,7 +168,8 @@ pub use collision::{
 pub use diagnostics::{DiagnosticsSettings, PhysicsDiagnostics};
 pub use error::{Error, Result};
 pub use integrator::{
-    ConstraintsActive, ImplicitEuler, Integrator, IntegratorOverride, IntegratorPlugin,
+    ConstraintsActive, ImplicitEuler, ImplicitState, Integrator, IntegratorOverride,
+    IntegratorPlugin,
 };
 pub use particles::{
     Advection, DampingPlugin, ExternalForce, ExternalImpulse, Force, Gravity, GravityPlugin,

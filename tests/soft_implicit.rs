@@ -125,6 +125,7 @@ fn cantilever(cells: [usize; 3]) -> f32 {
         // test below).
         max_newton: 3,
         max_cg: 5000,
+        ..ImplicitEuler::default()
     };
     let e = w.spawn((nodes, body, settings)).id();
     w.insert_resource(TipLoad(e, tip.clone(), 10.0));

@@ -234,6 +234,36 @@ fn polar_decomposition_is_a_rotation_times_a_symmetric_stretch_even_inverted() {
     }
 }
 
+/// F = R₀ S with S symmetric positive definite has the polar factor R₀, whichever path
+/// computes it: a mild stretch takes the fast (Newton) path, a very anisotropic one the SVD.
+#[test]
+fn polar_decomposition_returns_the_known_rotation_on_both_of_its_paths() {
+    let r0 = Mat3::from_quat(glam::Quat::from_axis_angle(
+        Vec3::new(1.0, 2.0, -0.5).normalize(),
+        2.1,
+    ));
+    let q = Mat3::from_quat(glam::Quat::from_axis_angle(
+        Vec3::new(-0.3, 0.4, 1.0).normalize(),
+        0.7,
+    ));
+    for sigma in [
+        Vec3::new(1.0, 1.0, 1.0),
+        Vec3::new(1.0001, 0.9999, 1.0),
+        Vec3::new(1.2, 0.9, 1.05),
+        Vec3::new(3.0, 0.5, 1.0),
+        Vec3::new(10.0, 0.1, 0.05),
+        Vec3::new(2.0, 2.0, 0.01),
+    ] {
+        let stretch = q * Mat3::from_diagonal(sigma) * q.transpose();
+        let (r, s) = polar_decomposition(r0 * stretch);
+        assert!(r.abs_diff_eq(r0, 2e-5), "{sigma}: {r} vs {r0}");
+        assert!(
+            s.abs_diff_eq(stretch, 1e-4 * sigma.max_element()),
+            "{sigma}: {s}"
+        );
+    }
+}
+
 /// Gradient descent on Ψ from an element flattened through itself (F₃₃ = −0.5).
 fn relax(model: StrainModel, lame: Lame) -> Mat3 {
     let mut f = Mat3::from_diagonal(Vec3::new(1.0, 1.0, -0.5));

@@ -311,6 +311,7 @@ pub fn strain_dial(cfg: &Config) {
                 tolerance: 1e-6,
                 max_newton: 3,
                 max_cg: 5000,
+                ..ImplicitEuler::default()
             }
         } else {
             ImplicitEuler::default()

@@ -31,6 +31,7 @@
 //! t = 0.3 s for a 1 s period).
 
 mod plugin;
+pub(crate) mod skyline;
 mod stages;
 
 pub use plugin::{ConstraintsActive, IntegratorPlugin};
@@ -120,6 +121,7 @@ impl Integrator {
 /// per step. Put it on an entity beside the mesh ([`crate::soft::SoftBody`]); the constant
 /// forces of the step (gravity, external, damping) enter as f_ext.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[require(ImplicitState)]
 pub struct ImplicitEuler {
     /// Newton stops when the gradient's norm has fallen below this fraction of the step's
     /// force scale — its first gradient, or for a body at rest its weight and momentum over
@@ -131,6 +133,28 @@ pub struct ImplicitEuler {
     /// Conjugate-gradient iterations per Newton step at most (default 200); each solve stops
     /// at a relative residual of 1e-3.
     pub max_cg: u32,
+    /// The conjugate gradients are preconditioned by a Cholesky factor of the system matrix
+    /// when that factor (its envelope after a reverse Cuthill–McKee ordering) holds at most
+    /// this many numbers (8 bytes each; default 2,000,000, 16 MB); a larger body falls back
+    /// to the diagonal (Jacobi). 0 turns the factor off.
+    pub max_factor_entries: usize,
+    /// The factor is kept from step to step and renewed when a solve needed more than this
+    /// many conjugate-gradient iterations (default 4): a factor of a nearby matrix is still
+    /// an exact-enough preconditioner, and renewing it costs about a bandwidth² times the
+    /// unknowns.
+    pub refactor_after: u32,
+}
+
+/// What the implicit solve keeps from one step to the next for one body (the preconditioner's
+/// factor); added with [`ImplicitEuler`], nothing to set.
+#[derive(Component, Debug, Clone, Default)]
+pub struct ImplicitState {
+    pub(crate) factor: Option<skyline::SkylineCholesky>,
+    /// (nodes, elements) the factor's pattern was built for; `None` before the first build.
+    pub(crate) built_for: Option<(usize, usize)>,
+    /// The substep the factor was made at, and whether the last solve asked for a new one.
+    pub(crate) h: f32,
+    pub(crate) refactor: bool,
 }
 
 impl Default for ImplicitEuler {
@@ -139,6 +163,8 @@ impl Default for ImplicitEuler {
             tolerance: 1e-3,
             max_newton: 8,
             max_cg: 200,
+            max_factor_entries: 2_000_000,
+            refactor_after: 4,
         }
     }
 }

@@ -5,7 +5,7 @@ use bevy_ecs::prelude::*;
 use super::SoftBody;
 use crate::WorldPlugin;
 use crate::diagnostics::PhysicsDiagnostics;
-use crate::integrator::ImplicitEuler;
+use crate::integrator::{ImplicitEuler, ImplicitState};
 use crate::particles::Nodes;
 use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::schedule::{
@@ -82,15 +82,25 @@ fn apply_elastic_forces(
 fn solve_implicit(
     mut commands: Commands,
     time: Res<SubstepTime>,
-    mut bodies: Query<(Entity, &mut Nodes, &mut SoftBody, &ImplicitEuler), Live>,
+    mut bodies: Query<
+        (
+            Entity,
+            &mut Nodes,
+            &mut SoftBody,
+            &ImplicitEuler,
+            &mut ImplicitState,
+        ),
+        Live,
+    >,
     mut scratch: Local<super::implicit::Scratch>,
 ) {
-    for (e, mut nodes, mut body, settings) in &mut bodies {
+    for (e, mut nodes, mut body, settings, mut state) in &mut bodies {
         let body = body.bypass_change_detection();
         match super::implicit::step(
             body,
             nodes.bypass_change_detection(),
             settings,
+            state.bypass_change_detection(),
             time.h,
             &mut scratch,
         ) {

@@ -46,6 +46,34 @@ pub fn polar_decomposition(f: Mat3) -> (Mat3, Mat3) {
 }
 
 fn polar_f64(f: DMat3) -> (DMat3, DMat3) {
+    // Away from inversion, Higham's scaled Newton iteration X ← ½(γX + X⁻ᵀ/γ) converges
+    // quadratically to the same R as the SVD (the polar factor of a non-singular F is
+    // unique) at a fifth of its cost: no trigonometry, three or four 3 × 3 inverses for the
+    // strains an elastic body sees. Near and through inversion the SVD path below decides
+    // the sign convention.
+    let norm2 = f.x_axis.length_squared() + f.y_axis.length_squared() + f.z_axis.length_squared();
+    let det = f.determinant();
+    let mean2 = norm2 / 3.0;
+    if det > 0.05 * mean2 * mean2.sqrt() {
+        let mut x = f;
+        for k in 0..16 {
+            let inv = x.inverse();
+            // Scaling pays on the first step of a large stretch; near R, γ is 1 anyway.
+            let gamma = if k == 0 {
+                (frobenius2(inv) / frobenius2(x)).sqrt().sqrt()
+            } else {
+                1.0
+            };
+            let next = 0.5 * (gamma * x + inv.transpose() / gamma);
+            let change = frobenius2(next - x);
+            x = next;
+            // The error after a step is about the square of the step: 1e-7 leaves 1e-14,
+            // far below the f32 the result is used in.
+            if change < 1e-14 {
+                return (x, symmetric(x.transpose() * f));
+            }
+        }
+    }
     let svd = glamx::DSvd3::from_matrix(f);
     let (mut u, mut sigma, mut v) = (svd.u, svd.s, svd.vt.transpose());
     // Make U and V proper rotations; each flip keeps F = U Σ Vᵀ by moving the sign into the
@@ -62,6 +90,10 @@ fn polar_f64(f: DMat3) -> (DMat3, DMat3) {
     let r = u * v.transpose();
     let s = v * DMat3::from_diagonal(sigma) * v.transpose();
     (r, symmetric(s))
+}
+
+fn frobenius2(m: DMat3) -> f64 {
+    m.x_axis.length_squared() + m.y_axis.length_squared() + m.z_axis.length_squared()
 }
 
 fn symmetric(m: DMat3) -> DMat3 {
@@ -220,34 +252,86 @@ impl StrainModel {
     /// cofactor) is done once.
     #[must_use]
     pub fn differentials(self, f: Mat3, lame: Lame) -> [Mat3; 9] {
-        let prepared = Prepared::new(self, f, lame);
-        std::array::from_fn(|k| {
-            let mut e = [0.0f32; 9];
-            e[k] = 1.0;
-            prepared.differential(Mat3::from_cols_array(&e), lame)
-        })
+        Prepared::new(self, f, lame).differentials(lame)
     }
 }
 
-/// What a model's stress differential needs of F, computed once per F.
-enum Prepared {
-    Green { f: Mat3, stress: Mat3 },
-    Cauchy,
-    Corotated { r: Mat3, s: Mat3 },
-    StableNeoHookean { f: Mat3, j: f32, cofactor: Mat3 },
+/// What a model's stress and stress differential need of F, computed once per F (for the
+/// co-rotated model, the polar decomposition: the expensive part of every evaluation).
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Prepared {
+    Green {
+        f: Mat3,
+        stress: Mat3,
+    },
+    Cauchy {
+        f: Mat3,
+    },
+    Corotated {
+        f: Mat3,
+        r: Mat3,
+        s: Mat3,
+        g_inv: Option<Mat3>,
+    },
+    StableNeoHookean {
+        f: Mat3,
+        j: f32,
+        cofactor: Mat3,
+    },
 }
 
 impl Prepared {
-    fn new(model: StrainModel, f: Mat3, lame: Lame) -> Self {
+    /// Ψ(F) and P(F), as [`StrainModel::stress`] but from the prepared decomposition.
+    pub(crate) fn stress(&self, model: StrainModel, lame: Lame) -> Stress {
+        let Lame { mu, lambda } = lame;
+        match *self {
+            Prepared::Corotated { f, r, s, .. } => {
+                let e = s - Mat3::IDENTITY;
+                Stress {
+                    energy: mu * ddot(e, e) + 0.5 * lambda * trace(e).powi(2),
+                    piola: 2.0 * mu * (f - r) + lambda * trace(e) * r,
+                }
+            }
+            Prepared::Green { f, .. }
+            | Prepared::Cauchy { f }
+            | Prepared::StableNeoHookean { f, .. } => model.stress(f, lame),
+        }
+    }
+
+    /// The F it was prepared from.
+    pub(crate) fn deformation(&self) -> Mat3 {
+        match *self {
+            Prepared::Green { f, .. }
+            | Prepared::Cauchy { f }
+            | Prepared::Corotated { f, .. }
+            | Prepared::StableNeoHookean { f, .. } => f,
+        }
+    }
+
+    /// The columns of ∂P/∂F (see [`StrainModel::differentials`]).
+    pub(crate) fn differentials(&self, lame: Lame) -> [Mat3; 9] {
+        std::array::from_fn(|k| {
+            let mut e = [0.0f32; 9];
+            e[k] = 1.0;
+            self.differential(Mat3::from_cols_array(&e), lame)
+        })
+    }
+
+    pub(crate) fn new(model: StrainModel, f: Mat3, lame: Lame) -> Self {
         match model {
             StrainModel::Green => Prepared::Green {
                 f,
                 stress: linear_stress(green_strain(f), lame),
             },
-            StrainModel::Cauchy => Prepared::Cauchy,
+            StrainModel::Cauchy => Prepared::Cauchy { f },
             StrainModel::Corotated => {
                 let (r, s) = polar_decomposition(f);
-                Prepared::Corotated { r, s }
+                Prepared::Corotated {
+                    f,
+                    r,
+                    s,
+                    g_inv: rotation_system_inverse(s),
+                }
             }
             StrainModel::StableNeoHookean => Prepared::StableNeoHookean {
                 f,
@@ -264,9 +348,11 @@ impl Prepared {
                 let de = 0.5 * (df.transpose() * f + f.transpose() * df);
                 df * stress + f * linear_stress(de, lame)
             }
-            Prepared::Cauchy => lambda * trace(df) * Mat3::IDENTITY + mu * (df + df.transpose()),
-            Prepared::Corotated { r, s } => {
-                let dr = rotation_differential(r, s, df);
+            Prepared::Cauchy { .. } => {
+                lambda * trace(df) * Mat3::IDENTITY + mu * (df + df.transpose())
+            }
+            Prepared::Corotated { r, s, g_inv, .. } => {
+                let dr = rotation_differential(r, g_inv, df);
                 let e = trace(s) - 3.0;
                 2.0 * mu * df
                     + lambda * trace(r.transpose() * df) * r
@@ -283,16 +369,17 @@ impl Prepared {
 /// dR for F = R S moved by dF: RᵀdR = [ω]× with (tr S · I − S) ω = axial(RᵀdF − dFᵀR), from
 /// the skew part of RᵀdF = [ω]× S + dS. Where two singular values sum to zero (a flat
 /// element flipping) the system is singular; ω is then taken from its regular part.
-fn rotation_differential(r: Mat3, s: Mat3, df: Mat3) -> Mat3 {
+fn rotation_differential(r: Mat3, g_inv: Option<Mat3>, df: Mat3) -> Mat3 {
     let m = r.transpose() * df;
     let a = m - m.transpose();
     let axial = Vec3::new(a.y_axis.z, a.z_axis.x, a.x_axis.y);
+    let omega = g_inv.map_or(Vec3::ZERO, |g| g * axial);
+    r * cross_matrix(omega)
+}
+
+/// (tr S · I − S)⁻¹, or None where it is singular.
+fn rotation_system_inverse(s: Mat3) -> Option<Mat3> {
     let g = trace(s) * Mat3::IDENTITY - s;
     let det = g.determinant();
-    let omega = if det.abs() > 1e-12 * (1.0 + trace(s).abs().powi(3)) {
-        g.inverse() * axial
-    } else {
-        Vec3::ZERO
-    };
-    r * cross_matrix(omega)
+    (det.abs() > 1e-12 * (1.0 + trace(s).abs().powi(3))).then(|| g.inverse())
 }
