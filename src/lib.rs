@@ -184,7 +184,8 @@ pub use rigid::{
     SkipRenormalization, Torque,
 };
 pub use schedule::{
-    ForceSchedule, ForceSystems, PhysicsSchedule, PhysicsSystems, StepSystems, SubstepSchedule,
+    ForceSchedule, ForceSystems, PhysicsSchedule, PhysicsSystems, RelaxSystems, StepSystems,
+    SubstepSchedule,
 };
 pub use sleep::{SleepPlugin, SleepSettings, Sleeping, SleepingDisabled};
 pub use springs::{Chain, ChainBuilder, ClothBuilder, Spring, SpringNetwork, SpringPlugin};

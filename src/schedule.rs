@@ -14,6 +14,8 @@
 //!   StepSystems::SolveConstraints   contacts and joints act on velocities here
 //!   StepSystems::IntegratePositions
 //!   StepSystems::RelaxConstraints   contacts again without position bias (soft step)
+//!     RelaxSystems::Rigid             rigid contacts
+//!     RelaxSystems::Soft              soft-body attachments, then node contacts
 //!   StepSystems::CompleteStages     extra force evaluations of Verlet and RK4
 //!   StepSystems::Renormalize        unit quaternions
 //!
@@ -116,6 +118,17 @@ pub enum IntegrationSystems {
     Impulses,
     /// The velocity phase of each integrator, linear and angular.
     Integrate,
+}
+
+/// The stages inside [`StepSystems::RelaxConstraints`]: the rigid contacts' relax pass, then
+/// the soft bodies' attachments (which move rigid bodies too) and node contacts, which have
+/// the last word on where a node may be.
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum RelaxSystems {
+    /// Rigid contacts without bias.
+    Rigid,
+    /// Soft-body attachments, then soft-body node contacts.
+    Soft,
 }
 
 /// The stages of [`PhysicsSystems::Prepare`]: user inputs first (kinematic targets, written
@@ -236,6 +249,11 @@ pub(crate) fn init_schedules(world: &mut World) {
         (IntegrationSystems::Impulses, IntegrationSystems::Integrate)
             .chain()
             .in_set(StepSystems::IntegrateVelocities),
+    );
+    substep.configure_sets(
+        (RelaxSystems::Rigid, RelaxSystems::Soft)
+            .chain()
+            .in_set(StepSystems::RelaxConstraints),
     );
 
     let mut forces = new_schedule(ForceSchedule, false);

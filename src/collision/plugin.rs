@@ -76,7 +76,7 @@ impl WorldPlugin for CollisionPlugin {
                     .in_set(StepSystems::SolveConstraints),
                 relax_contacts
                     .run_if(contacts_active)
-                    .in_set(StepSystems::RelaxConstraints),
+                    .in_set(crate::schedule::RelaxSystems::Rigid),
             ),
         );
     }

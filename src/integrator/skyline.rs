@@ -99,6 +99,8 @@ pub(crate) struct SkylineCholesky {
     values: Vec<f64>,
     /// Whether `values` holds a valid factor.
     factored: bool,
+    /// Counts the factorisations, so that what was derived from a factor can tell it is stale.
+    generation: u64,
 }
 
 impl SkylineCholesky {
@@ -139,6 +141,7 @@ impl SkylineCholesky {
             start,
             values: vec![0.0; entries],
             factored: false,
+            generation: 0,
         })
     }
 
@@ -146,6 +149,12 @@ impl SkylineCholesky {
     #[must_use]
     pub(crate) fn is_factored(&self) -> bool {
         self.factored
+    }
+
+    /// Which factorisation is held (changes with every [`Self::factor`]).
+    #[must_use]
+    pub(crate) fn generation(&self) -> u64 {
+        self.generation
     }
 
     /// Factors the matrix that `fill` writes: it receives a callback `add(i, j, block)` to call
@@ -177,6 +186,7 @@ impl SkylineCholesky {
             };
             fill(&mut add);
         }
+        self.generation += 1;
         self.factored = self.decompose();
         self.factored
     }

@@ -29,6 +29,7 @@
 //! Eberle's course notes (2020), without the −½ μ log(I_C + 1) term, with λ′ = λ + μ so that
 //! small strains match linear elasticity. Units: Pa for E, μ, λ, P; J/m³ for Ψ.
 
+mod attach;
 mod contact;
 mod implicit;
 mod io;
@@ -37,6 +38,7 @@ mod plugin;
 pub mod strain;
 mod targets;
 
+pub use attach::{MAX_ATTACHED_NODES, NodeAttachments};
 pub use implicit::ImplicitReport;
 pub use mesh::{CellSplit, TetMesh};
 pub use plugin::SoftBodyPlugin;

@@ -9,8 +9,8 @@ use crate::integrator::{ImplicitEuler, ImplicitState};
 use crate::particles::Nodes;
 use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::schedule::{
-    FinishSystems, ForceSystems, IntegrationSystems, PhysicsSchedule, StepSystems, SubstepSchedule,
-    add_force_systems, add_systems,
+    FinishSystems, ForceSystems, IntegrationSystems, PhysicsSchedule, RelaxSystems,
+    SubstepSchedule, add_force_systems, add_systems,
 };
 use crate::time::SubstepTime;
 
@@ -32,19 +32,30 @@ impl WorldPlugin for SoftBodyPlugin {
                 .run_if(any_with_component::<ImplicitEuler>)
                 .in_set(IntegrationSystems::Integrate),
         );
+        // Attachments first (chained: both move nodes), so that the contacts have the last
+        // word on where a node may be.
         add_systems(
             world,
             SubstepSchedule,
-            super::contact::collide_nodes
-                .run_if(any_with_component::<SoftBody>)
-                .run_if(any_with_component::<crate::collision::Collider>)
-                .in_set(StepSystems::RelaxConstraints),
+            (
+                super::attach::solve_attachments
+                    .run_if(any_with_component::<super::NodeAttachments>),
+                super::contact::collide_nodes
+                    .run_if(any_with_component::<SoftBody>)
+                    .run_if(any_with_component::<crate::collision::Collider>),
+            )
+                .chain()
+                .in_set(RelaxSystems::Soft),
         );
         add_systems(
             world,
             PhysicsSchedule,
-            super::targets::drive_node_targets
-                .run_if(any_with_component::<super::NodeTargets>)
+            (
+                super::targets::drive_node_targets.run_if(any_with_component::<super::NodeTargets>),
+                super::attach::anchor_attachments
+                    .run_if(any_with_component::<super::NodeAttachments>),
+            )
+                .chain()
                 .in_set(crate::schedule::PrepareSystems::Inputs),
         );
         add_systems(

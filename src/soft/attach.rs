@@ -1,0 +1,384 @@
+//! Soft-body nodes attached to rigid bodies, two-way: the body carries the nodes and feels
+//! the soft body's pull.
+//!
+//! After both have moved in a substep, each attachment is a position constraint
+//! C_k = x_k − p_k = 0 between node k and its point p_k = x_B + R (l_k − c) on the body. One
+//! impulse λ_k (N·s) per node, +λ on the node and −λ on the body at p_k, closes every gap at
+//! once:
+//!
+//! ```text
+//! (W_soft + W_body) λ = −C / h
+//! W_soft = H⁻¹ / h²                         (the implicit solve's response; M⁻¹ when explicit)
+//! W_body(k, l) = I₃ / M − [r_k]× I⁻¹ [r_l]×   (r = p − x_B; zero for a static or kinematic body)
+//! ```
+//!
+//! H is the backward-Euler system matrix M/h² + K + D/h of the soft body's last solve, so
+//! the constraint sees the body's stiffness, not a lone node's mass: a stiff bar holding a
+//! heavy box passes the box's weight through the bar in one substep instead of letting the
+//! box sink while a light node absorbs the impulses. The response comes from the solve's
+//! Cholesky factor (3 solves per attached node, kept until the factor is renewed); a body
+//! without a factor (above `max_factor_entries`, or explicit) uses its lumped masses, which
+//! couple more softly. Then the soft body moves by Δx = H⁻¹ Λ / h (v += Δx/h) and the rigid
+//! body's v, L, x and q by the opposite impulses, so momentum passes exactly between them.
+
+use bevy_ecs::prelude::*;
+use glam::{DVec3, Mat3, Quat, Vec3, Vec3A};
+use nalgebra::{DMatrix, DVector};
+
+use crate::error::{Error, Result};
+use crate::integrator::{ImplicitEuler, ImplicitState};
+use crate::particles::{LinearVelocity, Mass, Nodes, Position};
+use crate::quarantine::Quarantined;
+use crate::rigid::{AngularMomentum, AngularVelocity, CenterOfMass, Inertia, Rotation};
+use crate::time::SubstepTime;
+
+/// The most nodes one attachment holds: its constraint is solved as one dense 3n × 3n system.
+pub const MAX_ATTACHED_NODES: usize = 128;
+
+/// Nodes of the [`Nodes`] on this entity (a [`super::SoftBody`]'s, or any mesh's) attached
+/// to rigid bodies. A node keeps the place on the body it had when the attachment first ran
+/// (its offset in the body's frame), and both sides exchange impulses from then on (see the
+/// module docs). Pinned nodes are skipped; a missing or quarantined body leaves its nodes
+/// free until it is back.
+#[derive(Component, Debug, Clone, Default)]
+pub struct NodeAttachments {
+    links: Vec<Link>,
+}
+
+#[derive(Debug, Clone)]
+struct Link {
+    body: Entity,
+    nodes: Vec<u32>,
+    /// The nodes' points in the body's frame (m), set at the first substep.
+    local: Vec<Vec3>,
+    /// The impulse the body got in the last substep (N·s, world) and that substep's length.
+    impulse: Vec3,
+    h: f32,
+    /// W_soft for the nodes, kept while the factor it came from is held.
+    response: Option<(u64, f32, DMatrix<f64>)>,
+}
+
+impl NodeAttachments {
+    /// Attachments to one body: `nodes` are node indices of this entity's mesh.
+    ///
+    /// # Errors
+    /// As [`NodeAttachments::attach`].
+    pub fn new(body: Entity, nodes: impl IntoIterator<Item = usize>) -> Result<Self> {
+        let mut a = Self::default();
+        a.attach(body, nodes)?;
+        Ok(a)
+    }
+
+    /// Attaches `nodes` to `body` where they are at the next substep (replacing an earlier
+    /// attachment to the same body).
+    ///
+    /// # Errors
+    /// [`Error::TooFew`] for no nodes; [`Error::OutOfRange`] for more than
+    /// [`MAX_ATTACHED_NODES`]; [`Error::IndexOutOfRange`] for an index past `u32` (indices
+    /// past the mesh's nodes are skipped when the step meets them).
+    pub fn attach(&mut self, body: Entity, nodes: impl IntoIterator<Item = usize>) -> Result<()> {
+        let mut list = Vec::new();
+        for i in nodes {
+            list.push(u32::try_from(i).map_err(|_| Error::IndexOutOfRange {
+                what: "attached node",
+                index: i,
+                len: u32::MAX as usize,
+            })?);
+        }
+        list.sort_unstable();
+        list.dedup();
+        if list.is_empty() {
+            return Err(Error::TooFew {
+                what: "attached nodes",
+                min: 1,
+                got: 0,
+            });
+        }
+        if list.len() > MAX_ATTACHED_NODES {
+            return Err(Error::OutOfRange {
+                what: "attached nodes per body",
+                value: list.len() as f32,
+                range: "at most MAX_ATTACHED_NODES (128)",
+            });
+        }
+        self.detach(body);
+        self.links.push(Link {
+            body,
+            nodes: list,
+            local: Vec::new(),
+            impulse: Vec3::ZERO,
+            h: 0.0,
+            response: None,
+        });
+        Ok(())
+    }
+
+    /// Lets go of `body`.
+    pub fn detach(&mut self, body: Entity) {
+        self.links.retain(|l| l.body != body);
+    }
+
+    /// The bodies attached.
+    pub fn bodies(&self) -> impl Iterator<Item = Entity> + '_ {
+        self.links.iter().map(|l| l.body)
+    }
+
+    /// The force the soft body exerted on `body` over the last substep (N, world frame):
+    /// its impulse over the substep's length. None if not attached or not yet run.
+    #[must_use]
+    pub fn force_on(&self, body: Entity) -> Option<Vec3> {
+        let l = self.links.iter().find(|l| l.body == body)?;
+        (l.h > 0.0).then(|| l.impulse / l.h)
+    }
+}
+
+type Soft<'a> = (
+    &'a mut Nodes,
+    &'a mut NodeAttachments,
+    Option<&'a mut ImplicitState>,
+    Option<&'a ImplicitEuler>,
+);
+
+type Body<'a> = (
+    &'a mut Position,
+    &'a mut Rotation,
+    Option<&'a mut LinearVelocity>,
+    Option<&'a mut AngularMomentum>,
+    Option<&'a mut AngularVelocity>,
+    Option<&'a Mass>,
+    Option<&'a Inertia>,
+    Option<&'a CenterOfMass>,
+);
+
+/// Solves every attachment once per substep, after both sides have moved.
+pub(crate) fn solve_attachments(
+    time: Res<SubstepTime>,
+    mut meshes: Query<Soft, Without<Quarantined>>,
+    mut bodies: Query<Body, (Without<Quarantined>, Without<Nodes>)>,
+) {
+    let h = time.h;
+    if h.is_nan() || h <= 0.0 {
+        return;
+    }
+    for (mut nodes, mut attachments, mut state, implicit) in &mut meshes {
+        let nodes = nodes.bypass_change_detection();
+        let factor = state
+            .as_deref_mut()
+            .filter(|_| implicit.is_some())
+            .and_then(|s| s.factor.as_ref())
+            .filter(|f| f.is_factored());
+        for link in &mut attachments.bypass_change_detection().links {
+            link.impulse = Vec3::ZERO;
+            link.h = h;
+            let Ok(body) = bodies.get_mut(link.body) else {
+                continue;
+            };
+            solve_link(link, nodes, body, factor, h);
+        }
+    }
+}
+
+fn solve_link(
+    link: &mut Link,
+    n: &mut Nodes,
+    (mut x, mut q, v, l, w, mass, inertia, com): bevy_ecs::query::QueryItem<'_, '_, Body<'_>>,
+    factor: Option<&crate::integrator::skyline::SkylineCholesky>,
+    h: f32,
+) {
+    let len = n.x.len();
+    let com = com.map_or(Vec3::ZERO, |c| c.0);
+    if link.local.len() != link.nodes.len() {
+        // Not anchored before the step (the body appeared since): anchor now.
+        anchor(link, n, &x, &q, com);
+    }
+    // The nodes that take part: in range and free.
+    let active: Vec<usize> = (0..link.nodes.len())
+        .filter(|&k| (link.nodes[k] as usize) < len && n.inv_mass[link.nodes[k] as usize] > 0.0)
+        .collect();
+    if active.is_empty() {
+        return;
+    }
+    let a = active.len();
+    let hd = f64::from(h);
+    // W_soft, from the factor (cached per factorisation) or the lumped masses.
+    let cached = matches!(
+        (&link.response, factor),
+        (Some((g, hh, m)), Some(f)) if *g == f.generation() && *hh == h && m.nrows() == 3 * a
+    );
+    if !cached {
+        link.response = factor.map(|f| {
+            let mut w = DMatrix::<f64>::zeros(3 * a, 3 * a);
+            let (mut e, mut z, mut work) = (vec![DVec3::ZERO; len], vec![DVec3::ZERO; len], vec![]);
+            for (col, &kc) in active.iter().enumerate() {
+                for c in 0..3 {
+                    let node = link.nodes[kc] as usize;
+                    e[node][c] = 1.0;
+                    f.solve(&e, &mut z, &mut work);
+                    e[node][c] = 0.0;
+                    for (row, &kr) in active.iter().enumerate() {
+                        let zr = z[link.nodes[kr] as usize];
+                        for r in 0..3 {
+                            w[(3 * row + r, 3 * col + c)] = zr[r] / (hd * hd);
+                        }
+                    }
+                }
+            }
+            (f.generation(), h, w)
+        });
+    }
+    let mut system = match &link.response {
+        Some((_, _, w)) if factor.is_some() => w.clone(),
+        _ => {
+            let mut w = DMatrix::<f64>::zeros(3 * a, 3 * a);
+            for (row, &k) in active.iter().enumerate() {
+                let inv = f64::from(n.inv_mass[link.nodes[k] as usize]);
+                for r in 0..3 {
+                    w[(3 * row + r, 3 * row + r)] = inv;
+                }
+            }
+            w
+        }
+    };
+    // The body's points, and W_body for a dynamic body.
+    let rot = Mat3::from_quat(q.0);
+    let points: Vec<Vec3> = active
+        .iter()
+        .map(|&k| Vec3::from(x.0) + rot * (link.local[k] - com))
+        .collect();
+    let inv_mass = mass.map_or(0.0, |m| m.inverse());
+    let inv_inertia = inertia.map_or(Mat3::ZERO, |i| i.world_inverse_tensor(q.0));
+    let dynamic = v.is_some() && (inv_mass > 0.0 || inv_inertia != Mat3::ZERO);
+    // The body feels each impulse at the node, not at its own point, so that the pair acts at
+    // one place and turns nothing: the exchange keeps the angular momentum.
+    let at: Vec<Vec3> = active
+        .iter()
+        .map(|&k| Vec3::from(n.x[link.nodes[k] as usize]))
+        .collect();
+    if dynamic {
+        let arms: Vec<Mat3> = at
+            .iter()
+            .map(|p| cross_matrix(*p - Vec3::from(x.0)))
+            .collect();
+        for k in 0..a {
+            for m in 0..a {
+                let block =
+                    Mat3::from_diagonal(Vec3::splat(inv_mass)) - arms[k] * inv_inertia * arms[m];
+                for r in 0..3 {
+                    for c in 0..3 {
+                        system[(3 * k + r, 3 * m + c)] += f64::from(block.col(c)[r]);
+                    }
+                }
+            }
+        }
+    }
+    let mut rhs = DVector::<f64>::zeros(3 * a);
+    for (row, &k) in active.iter().enumerate() {
+        let gap = Vec3::from(n.x[link.nodes[k] as usize]) - points[row];
+        for r in 0..3 {
+            rhs[3 * row + r] = -f64::from(gap[r]) / hd;
+        }
+    }
+    let scale = system.diagonal().amax().max(f64::MIN_POSITIVE);
+    let Some(lambda) = (system.clone() + DMatrix::identity(3 * a, 3 * a) * (1e-12 * scale))
+        .cholesky()
+        .map(|c| c.solve(&rhs))
+        .or_else(|| system.lu().solve(&rhs))
+    else {
+        return;
+    };
+    if !lambda.iter().all(|v| v.is_finite()) {
+        return;
+    }
+    let impulse =
+        |row: usize| DVec3::new(lambda[3 * row], lambda[3 * row + 1], lambda[3 * row + 2]);
+    // The soft side: Δx = H⁻¹ Λ / h (or h M⁻¹ Λ), v += Δx / h.
+    if let Some(f) = factor {
+        let mut rhs = vec![DVec3::ZERO; len];
+        for (row, &k) in active.iter().enumerate() {
+            rhs[link.nodes[k] as usize] = impulse(row) / hd;
+        }
+        let mut dx = vec![DVec3::ZERO; len];
+        f.solve(&rhs, &mut dx, &mut Vec::new());
+        for (i, dx) in dx.iter().enumerate() {
+            if n.inv_mass[i] > 0.0 {
+                let d = Vec3A::from(dx.as_vec3());
+                n.x[i] += d;
+                n.v[i] += d / h;
+            }
+        }
+    } else {
+        for (row, &k) in active.iter().enumerate() {
+            let i = link.nodes[k] as usize;
+            let dv = Vec3A::from((impulse(row) * f64::from(n.inv_mass[i])).as_vec3());
+            n.v[i] += dv;
+            n.x[i] += h * dv;
+        }
+    }
+    // The body: the opposite impulses.
+    let mut total = Vec3::ZERO;
+    let mut angular = Vec3::ZERO;
+    for (row, p) in at.iter().enumerate() {
+        let j = -impulse(row).as_vec3();
+        total += j;
+        angular += (*p - Vec3::from(x.0)).cross(j);
+    }
+    link.impulse = total;
+    if !dynamic {
+        return;
+    }
+    let dv = total * inv_mass;
+    let dw = inv_inertia * angular;
+    if let Some(mut v) = v {
+        v.0 += Vec3A::from(dv);
+    }
+    if let Some(mut l) = l {
+        l.bypass_change_detection().0 += Vec3A::from(angular);
+    }
+    if let Some(mut w) = w {
+        w.bypass_change_detection().0 += Vec3A::from(dw);
+    }
+    // Positions too, as the integrator would have moved them with these velocities.
+    x.0 += Vec3A::from(h * dv);
+    let turn = Quat::from_xyzw(dw.x, dw.y, dw.z, 0.0) * q.0;
+    q.0 = (q.0 + turn * (0.5 * h)).normalize();
+}
+
+/// Each node's place in the body's frame, from where both are now.
+fn anchor(link: &mut Link, n: &Nodes, x: &Position, q: &Rotation, com: Vec3) {
+    let inverse = q.0.inverse();
+    link.local = link
+        .nodes
+        .iter()
+        .map(|&i| {
+            let p = n.x.get(i as usize).copied().unwrap_or(Vec3A::ZERO);
+            inverse * (Vec3::from(p) - Vec3::from(x.0)) + com
+        })
+        .collect();
+    link.response = None;
+}
+
+/// Before a step: new attachments take the nodes' places on their bodies as they are, before
+/// anything moves.
+pub(crate) fn anchor_attachments(
+    mut meshes: Query<(&Nodes, &mut NodeAttachments), Changed<NodeAttachments>>,
+    bodies: Query<(&Position, &Rotation, Option<&CenterOfMass>), Without<Nodes>>,
+) {
+    for (n, mut attachments) in &mut meshes {
+        for link in &mut attachments.bypass_change_detection().links {
+            if link.local.len() == link.nodes.len() {
+                continue;
+            }
+            if let Ok((x, q, com)) = bodies.get(link.body) {
+                anchor(link, n, x, q, com.map_or(Vec3::ZERO, |c| c.0));
+            }
+        }
+    }
+}
+
+fn cross_matrix(r: Vec3) -> Mat3 {
+    Mat3::from_cols(
+        Vec3::new(0.0, r.z, -r.y),
+        Vec3::new(-r.z, 0.0, r.x),
+        Vec3::new(r.y, -r.x, 0.0),
+    )
+}
