@@ -20,10 +20,19 @@
 //! without a factor (above `max_factor_entries`, or explicit) uses its lumped masses, which
 //! couple more softly. Then the soft body moves by Δx = H⁻¹ Λ / h (v += Δx/h) and the rigid
 //! body's v, L, x and q by the opposite impulses, so momentum passes exactly between them.
+//!
+//! Unlike contacts (see [`super::contact`]), the body moves in the same substep: a two-sided
+//! constraint that leaves the body's part of the gap to the next substep overshoots (tried:
+//! the bar's box hangs 16.4 mm low instead of 10.3). The price is that an attached body that
+//! also rests on rigid contacts can be pushed into them within a step, which its contacts
+//! then undo.
 
 use bevy_ecs::prelude::*;
-use glam::{DVec3, Mat3, Quat, Vec3, Vec3A};
+use glam::{Mat3, Vec3, Vec3A};
 use nalgebra::{DMatrix, DVector};
+
+use super::coupling::{RigidSide, move_soft, soft_response};
+use crate::integrator::skyline::SkylineCholesky;
 
 use crate::error::{Error, Result};
 use crate::integrator::{ImplicitEuler, ImplicitState};
@@ -182,7 +191,7 @@ fn solve_link(
     link: &mut Link,
     n: &mut Nodes,
     (mut x, mut q, v, l, w, mass, inertia, com): bevy_ecs::query::QueryItem<'_, '_, Body<'_>>,
-    factor: Option<&crate::integrator::skyline::SkylineCholesky>,
+    factor: Option<&SkylineCholesky>,
     h: f32,
 ) {
     let len = n.x.len();
@@ -199,85 +208,53 @@ fn solve_link(
         return;
     }
     let a = active.len();
-    let hd = f64::from(h);
-    // W_soft, from the factor (cached per factorisation) or the lumped masses.
+    let node = |k: usize| link.nodes[k] as usize;
+    let rows: Vec<(usize, Vec3)> = active
+        .iter()
+        .flat_map(|&k| [Vec3::X, Vec3::Y, Vec3::Z].map(|d| (node(k), d)))
+        .collect();
+    // G_soft, kept while the factor it came from is held.
     let cached = matches!(
         (&link.response, factor),
         (Some((g, hh, m)), Some(f)) if *g == f.generation() && *hh == h && m.nrows() == 3 * a
     );
     if !cached {
-        link.response = factor.map(|f| {
-            let mut w = DMatrix::<f64>::zeros(3 * a, 3 * a);
-            let (mut e, mut z, mut work) = (vec![DVec3::ZERO; len], vec![DVec3::ZERO; len], vec![]);
-            for (col, &kc) in active.iter().enumerate() {
-                for c in 0..3 {
-                    let node = link.nodes[kc] as usize;
-                    e[node][c] = 1.0;
-                    f.solve(&e, &mut z, &mut work);
-                    e[node][c] = 0.0;
-                    for (row, &kr) in active.iter().enumerate() {
-                        let zr = z[link.nodes[kr] as usize];
-                        for r in 0..3 {
-                            w[(3 * row + r, 3 * col + c)] = zr[r] / (hd * hd);
-                        }
-                    }
-                }
-            }
-            (f.generation(), h, w)
-        });
+        link.response = factor.map(|f| (f.generation(), h, soft_response(n, Some(f), &rows, h)));
     }
-    let mut system = match &link.response {
-        Some((_, _, w)) if factor.is_some() => w.clone(),
-        _ => {
-            let mut w = DMatrix::<f64>::zeros(3 * a, 3 * a);
-            for (row, &k) in active.iter().enumerate() {
-                let inv = f64::from(n.inv_mass[link.nodes[k] as usize]);
-                for r in 0..3 {
-                    w[(3 * row + r, 3 * row + r)] = inv;
-                }
-            }
-            w
-        }
+    let soft = match (&link.response, factor) {
+        (Some((_, _, g)), Some(_)) => g.clone(),
+        _ => soft_response(n, None, &rows, h),
     };
-    // The body's points, and W_body for a dynamic body.
+    let mut rigid = RigidSide {
+        x: Vec3::from(x.0),
+        v: v.as_ref().map_or(Vec3::ZERO, |v| Vec3::from(v.0)),
+        w: w.as_ref().map_or(Vec3::ZERO, |w| Vec3::from(w.0)),
+        inv_mass: mass.map_or(0.0, |m| m.inverse()),
+        inv_inertia: inertia.map_or(Mat3::ZERO, |i| i.world_inverse_tensor(q.0)),
+        dynamic: false,
+        linear: Vec3::ZERO,
+        angular: Vec3::ZERO,
+    };
+    rigid.dynamic = v.is_some() && (rigid.inv_mass > 0.0 || rigid.inv_inertia != Mat3::ZERO);
+    // The body feels each impulse at the node, not at its own point, so that the pair acts
+    // at one place and turns nothing: the exchange keeps the angular momentum.
+    let at: Vec<Vec3> = active.iter().map(|&k| Vec3::from(n.x[node(k)])).collect();
+    let body_rows: Vec<(Vec3, Vec3)> = rows
+        .iter()
+        .enumerate()
+        .map(|(r, &(_, d))| (at[r / 3], d))
+        .collect();
+    let system = soft + rigid.response(&body_rows);
+    // The gaps to close: each node to its point on the body.
     let rot = Mat3::from_quat(q.0);
-    let points: Vec<Vec3> = active
-        .iter()
-        .map(|&k| Vec3::from(x.0) + rot * (link.local[k] - com))
-        .collect();
-    let inv_mass = mass.map_or(0.0, |m| m.inverse());
-    let inv_inertia = inertia.map_or(Mat3::ZERO, |i| i.world_inverse_tensor(q.0));
-    let dynamic = v.is_some() && (inv_mass > 0.0 || inv_inertia != Mat3::ZERO);
-    // The body feels each impulse at the node, not at its own point, so that the pair acts at
-    // one place and turns nothing: the exchange keeps the angular momentum.
-    let at: Vec<Vec3> = active
-        .iter()
-        .map(|&k| Vec3::from(n.x[link.nodes[k] as usize]))
-        .collect();
-    if dynamic {
-        let arms: Vec<Mat3> = at
-            .iter()
-            .map(|p| cross_matrix(*p - Vec3::from(x.0)))
-            .collect();
-        for k in 0..a {
-            for m in 0..a {
-                let block =
-                    Mat3::from_diagonal(Vec3::splat(inv_mass)) - arms[k] * inv_inertia * arms[m];
-                for r in 0..3 {
-                    for c in 0..3 {
-                        system[(3 * k + r, 3 * m + c)] += f64::from(block.col(c)[r]);
-                    }
-                }
-            }
-        }
-    }
-    let mut rhs = DVector::<f64>::zeros(3 * a);
-    for (row, &k) in active.iter().enumerate() {
-        let gap = Vec3::from(n.x[link.nodes[k] as usize]) - points[row];
-        for r in 0..3 {
-            rhs[3 * row + r] = -f64::from(gap[r]) / hd;
-        }
-    }
+    let hd = f64::from(h);
+    let rhs = DVector::<f64>::from_iterator(
+        3 * a,
+        active.iter().enumerate().flat_map(|(row, &k)| {
+            let gap = at[row] - (Vec3::from(x.0) + rot * (link.local[k] - com));
+            gap.to_array().map(|g| -f64::from(g) / hd)
+        }),
+    );
     let scale = system.diagonal().amax().max(f64::MIN_POSITIVE);
     let Some(lambda) = (system.clone() + DMatrix::identity(3 * a, 3 * a) * (1e-12 * scale))
         .cholesky()
@@ -289,58 +266,36 @@ fn solve_link(
     if !lambda.iter().all(|v| v.is_finite()) {
         return;
     }
-    let impulse =
-        |row: usize| DVec3::new(lambda[3 * row], lambda[3 * row + 1], lambda[3 * row + 2]);
-    // The soft side: Δx = H⁻¹ Λ / h (or h M⁻¹ Λ), v += Δx / h.
-    if let Some(f) = factor {
-        let mut rhs = vec![DVec3::ZERO; len];
-        for (row, &k) in active.iter().enumerate() {
-            rhs[link.nodes[k] as usize] = impulse(row) / hd;
-        }
-        let mut dx = vec![DVec3::ZERO; len];
-        f.solve(&rhs, &mut dx, &mut Vec::new());
-        for (i, dx) in dx.iter().enumerate() {
-            if n.inv_mass[i] > 0.0 {
-                let d = Vec3A::from(dx.as_vec3());
-                n.x[i] += d;
-                n.v[i] += d / h;
-            }
-        }
-    } else {
-        for (row, &k) in active.iter().enumerate() {
-            let i = link.nodes[k] as usize;
-            let dv = Vec3A::from((impulse(row) * f64::from(n.inv_mass[i])).as_vec3());
-            n.v[i] += dv;
-            n.x[i] += h * dv;
-        }
+    let impulses: Vec<(usize, Vec3)> = (0..a)
+        .map(|row| {
+            let j = Vec3::new(
+                lambda[3 * row] as f32,
+                lambda[3 * row + 1] as f32,
+                lambda[3 * row + 2] as f32,
+            );
+            (node(active[row]), j)
+        })
+        .collect();
+    move_soft(n, factor, &impulses, h);
+    for (row, &(_, j)) in impulses.iter().enumerate() {
+        rigid.take(at[row], -j);
     }
-    // The body: the opposite impulses.
-    let mut total = Vec3::ZERO;
-    let mut angular = Vec3::ZERO;
-    for (row, p) in at.iter().enumerate() {
-        let j = -impulse(row).as_vec3();
-        total += j;
-        angular += (*p - Vec3::from(x.0)).cross(j);
-    }
-    link.impulse = total;
-    if !dynamic {
+    link.impulse = -impulses.iter().map(|&(_, j)| j).sum::<Vec3>();
+    if !rigid.touched() {
         return;
     }
-    let dv = total * inv_mass;
-    let dw = inv_inertia * angular;
+    let (dx, nq) = rigid.moved_pose(q.0, h);
     if let Some(mut v) = v {
-        v.0 += Vec3A::from(dv);
+        v.0 = Vec3A::from(rigid.v);
     }
     if let Some(mut l) = l {
-        l.bypass_change_detection().0 += Vec3A::from(angular);
+        l.bypass_change_detection().0 += Vec3A::from(rigid.angular);
     }
     if let Some(mut w) = w {
-        w.bypass_change_detection().0 += Vec3A::from(dw);
+        w.bypass_change_detection().0 = Vec3A::from(rigid.w);
     }
-    // Positions too, as the integrator would have moved them with these velocities.
-    x.0 += Vec3A::from(h * dv);
-    let turn = Quat::from_xyzw(dw.x, dw.y, dw.z, 0.0) * q.0;
-    q.0 = (q.0 + turn * (0.5 * h)).normalize();
+    x.0 += Vec3A::from(dx);
+    q.0 = nq;
 }
 
 /// Each node's place in the body's frame, from where both are now.
@@ -373,12 +328,4 @@ pub(crate) fn anchor_attachments(
             }
         }
     }
-}
-
-fn cross_matrix(r: Vec3) -> Mat3 {
-    Mat3::from_cols(
-        Vec3::new(0.0, r.z, -r.y),
-        Vec3::new(-r.z, 0.0, r.x),
-        Vec3::new(r.y, -r.x, 0.0),
-    )
 }

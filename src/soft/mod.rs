@@ -31,6 +31,7 @@
 
 mod attach;
 mod contact;
+mod coupling;
 mod implicit;
 mod io;
 pub mod mesh;
@@ -176,7 +177,8 @@ pub struct SoftBody {
     contacts: Vec<NodeContact>,
 }
 
-/// A node held outside a collider: the plane n·x ≥ d at the node's contact.
+/// A node held outside a static or kinematic collider: the plane n·x ≥ d at the node's
+/// contact, moving with the collider over the next substep.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct NodeContact {
     node: u32,

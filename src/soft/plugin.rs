@@ -32,6 +32,13 @@ impl WorldPlugin for SoftBodyPlugin {
                 .run_if(any_with_component::<ImplicitEuler>)
                 .in_set(IntegrationSystems::Integrate),
         );
+        add_systems(
+            world,
+            SubstepSchedule,
+            super::coupling::apply_soft_impulses
+                .run_if(any_with_component::<super::coupling::SoftImpulse>)
+                .in_set(crate::schedule::StepSystems::AccumulateTorque),
+        );
         // Attachments first (chained: both move nodes), so that the contacts have the last
         // word on where a node may be.
         add_systems(
