@@ -410,6 +410,7 @@ fn main() {
     }
     if run("dial") {
         accuracy_dial(&cfg);
+        soft::stretch_dial(&cfg);
         soft::strain_dial(&cfg);
     }
     println!("\n# total {:.1} s", start.elapsed().as_secs_f64());
