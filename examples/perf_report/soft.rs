@@ -287,22 +287,14 @@ pub fn cantilever_vs_rapier(cfg: &Config, steps: usize) {
 /// against small-strain linear elasticity (lateral 1 − 0.1 ν = 0.970, P₁₁/E = 0.100), and its
 /// elastic pass time on the stretched body relative to co-rotated's.
 pub fn stretch_dial(cfg: &Config) {
-    println!("\n# strain models: uniaxial stretch 1.1, nu = 0.3; linear elasticity: lateral 0.970, P11/E 0.100");
+    println!(
+        "\n# strain models: uniaxial stretch 1.1, nu = 0.3; linear elasticity: lateral 0.970, P11/E 0.100"
+    );
     let material = Material::new(1e6, 0.3, 1000.0).unwrap();
     let lame = material.lame();
     let lateral = |model: StrainModel| {
-        let p = |s: f32| model.first_piola(Mat3::from_diagonal(Vec3::new(1.1, s, s)), lame);
-        let (mut lo, mut hi) = (0.8f32, 1.0f32);
-        for _ in 0..60 {
-            let mid = 0.5 * (lo + hi);
-            if p(mid).y_axis.y < 0.0 {
-                lo = mid;
-            } else {
-                hi = mid;
-            }
-        }
-        let s = 0.5 * (lo + hi);
-        (s, p(s).x_axis.x / material.young())
+        let (s, p11) = model.uniaxial(1.1, lame);
+        (s, p11 / material.young())
     };
     let stretched = |model: StrainModel| {
         let (mesh, mut nodes, sb) = body(model);

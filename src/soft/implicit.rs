@@ -371,15 +371,7 @@ fn elastic_from(body: &SoftBody, piola: &[Mat3], out: &mut [Vec3A]) -> bool {
     for (k, t) in body.tets.iter().enumerate() {
         let h = -body.volume[k] * piola[k] * body.dm_inv[k].transpose();
         finite &= h.is_finite();
-        let (h1, h2, h3) = (
-            Vec3A::from(h.x_axis),
-            Vec3A::from(h.y_axis),
-            Vec3A::from(h.z_axis),
-        );
-        out[t[1] as usize] += h1;
-        out[t[2] as usize] += h2;
-        out[t[3] as usize] += h3;
-        out[t[0] as usize] -= h1 + h2 + h3;
+        super::scatter_element_forces(out, *t, h);
     }
     finite
 }

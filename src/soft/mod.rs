@@ -177,6 +177,21 @@ pub struct SoftBody {
     contacts: Vec<NodeContact>,
 }
 
+/// Adds an element's nodal forces: the columns of H = −V P Dm⁻ᵀ to corners 1..3, their
+/// negated sum to corner 0.
+#[inline]
+pub(crate) fn scatter_element_forces(f: &mut [Vec3A], t: [u32; 4], h: Mat3) {
+    let (h1, h2, h3) = (
+        Vec3A::from(h.x_axis),
+        Vec3A::from(h.y_axis),
+        Vec3A::from(h.z_axis),
+    );
+    f[t[1] as usize] += h1;
+    f[t[2] as usize] += h2;
+    f[t[3] as usize] += h3;
+    f[t[0] as usize] -= h1 + h2 + h3;
+}
+
 /// A node held outside a static or kinematic collider: the plane n·x ≥ d at the node's
 /// contact, moving with the collider over the next substep.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -315,15 +330,7 @@ impl SoftBody {
                 p += beta * self.model.differential(f_k, df, self.lame);
             }
             let h = -vol * p * dm_inv.transpose();
-            let (h1, h2, h3) = (
-                Vec3A::from(h.x_axis),
-                Vec3A::from(h.y_axis),
-                Vec3A::from(h.z_axis),
-            );
-            f[t[1] as usize] += h1;
-            f[t[2] as usize] += h2;
-            f[t[3] as usize] += h3;
-            f[t[0] as usize] -= h1 + h2 + h3;
+            scatter_element_forces(f, t, h);
             finite &= h.is_finite();
             let j = f_k.determinant();
             stats.elastic_energy += vol * s.energy;

@@ -186,6 +186,24 @@ impl StrainModel {
         }
     }
 
+    /// Uniaxial stretch `stretch` along x with free sides: the lateral stretch s at which the
+    /// lateral stress vanishes (found by bisection on [0.5, 1.5]) and the axial P₁₁ (Pa) there.
+    #[must_use]
+    pub fn uniaxial(self, stretch: f32, lame: Lame) -> (f32, f32) {
+        let p = |s: f32| self.first_piola(Mat3::from_diagonal(Vec3::new(stretch, s, s)), lame);
+        let (mut lo, mut hi) = (0.5f32, 1.5f32);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if p(mid).y_axis.y < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let s = 0.5 * (lo + hi);
+        (s, p(s).x_axis.x)
+    }
+
     /// Ψ(F) and P(F).
     #[must_use]
     pub fn stress(self, f: Mat3, lame: Lame) -> Stress {
