@@ -76,6 +76,11 @@ pub struct PhysicsDiagnostics {
     pub last_quarantined: Option<(Entity, QuarantineReason)>,
     /// Frame time dropped by the step cap in the last `advance_physics` call (s).
     pub dropped_time: f32,
+    /// The smallest explicit stability limit of the spring systems (s; 0 until the spring
+    /// plugin has looked, infinite without springs). See [`crate::springs::stability`].
+    pub spring_critical_step: f32,
+    /// Spring systems warned to be past their stability limit (each once).
+    pub stability_warnings: u64,
 }
 
 impl PhysicsDiagnostics {

@@ -176,7 +176,7 @@ pub use particles::{
     GravityScale, LinearDamping, LinearVelocity, Mass, Nodes, ParticleBundle, Position, Tracer,
     VelocityField, VelocityFieldPlugin,
 };
-pub use quarantine::{BodyQuarantined, QuarantineReason, Quarantined};
+pub use quarantine::{BodyQuarantined, DivergenceGuard, QuarantineReason, Quarantined};
 pub use rigid::{
     AngularDamping, AngularMomentum, AngularVelocity, CenterOfMass, ExternalForceAtPoint,
     ExternalImpulseAtPoint, ExternalTorque, Inertia, KinematicTarget, MassProperties,
@@ -188,7 +188,10 @@ pub use schedule::{
     SubstepSchedule,
 };
 pub use sleep::{SleepPlugin, SleepSettings, Sleeping, SleepingDisabled};
-pub use springs::{Chain, ChainBuilder, ClothBuilder, Spring, SpringNetwork, SpringPlugin};
+pub use springs::{
+    Chain, ChainBuilder, ClothBuilder, EntitySpringStability, Spring, SpringNetwork, SpringPlugin,
+    SpringStability, StabilityWarning,
+};
 pub use time::{FrameReport, PhysicsTime, SubstepTime};
 
 /// Everything a game needs in scope.
@@ -241,6 +244,7 @@ impl WorldPlugin for PhysicsCorePlugin {
         }
         world.init_resource::<SubstepTime>();
         world.init_resource::<Messages<BodyQuarantined>>();
+        world.init_resource::<quarantine::DivergenceGuard>();
         schedule::add_systems(
             world,
             PhysicsSchedule,
@@ -307,6 +311,9 @@ fn rotate_messages(world: &mut World) {
         m.update();
     }
     if let Some(mut m) = world.get_resource_mut::<Messages<ContactEnded>>() {
+        m.update();
+    }
+    if let Some(mut m) = world.get_resource_mut::<Messages<springs::StabilityWarning>>() {
         m.update();
     }
 }

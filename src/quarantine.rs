@@ -6,6 +6,11 @@
 //!   (constructors can't be bypassed for [`crate::Mass`], but `Position(Vec3::NAN)` can be
 //!   written by hand) is caught by the component's insert hook.
 //! - **Blow-up.** A body whose position or velocity is non-finite after integration.
+//! - **Runaway.** A body, or a node of a mesh, whose state is still finite but moving faster
+//!   than [`DivergenceGuard::max_speed`] — an explicit integrator past its stability limit
+//!   gets there in a step or two, long before f32 overflows (a stiff rope reached 1e23 m in
+//!   two steps, finite all along). And a spring whose force turned non-finite or whose strain
+//!   passed [`DivergenceGuard::max_spring_strain`] quarantines both its ends, naming it.
 //!
 //! Either way the entity gets [`Quarantined`], every physics system skips it (an archetype
 //! filter, so it costs nothing per body), a [`BodyQuarantined`] message is written, and
@@ -25,6 +30,66 @@ pub enum QuarantineReason {
     NonFiniteState,
     /// A component was inserted with an invalid value.
     InvalidInput(Error),
+    /// Its speed (m/s) passed [`DivergenceGuard::max_speed`] while finite: the integration
+    /// diverged. For a mesh, `node` is its fastest node.
+    Diverged {
+        /// The speed found (m/s).
+        speed: f32,
+        /// The mesh node, for a [`crate::Nodes`] mesh.
+        node: Option<u32>,
+    },
+    /// A spring attached to it failed: its force was not finite, or its strain |l − r| / r
+    /// passed [`DivergenceGuard::max_spring_strain`].
+    SpringFailed {
+        /// The spring entity.
+        spring: Entity,
+        /// Its strain when it failed (infinite or NaN for a non-finite force).
+        strain: f32,
+    },
+}
+
+/// When a finite state counts as diverged (see the module docs). Set a field to
+/// `f32::INFINITY` to turn that check off.
+#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+pub struct DivergenceGuard {
+    /// Speed beyond any body's in a game (m/s; default 1e4, ten times a rifle bullet's).
+    pub max_speed: f32,
+    /// Spring strain |l − r| / r beyond any rope's (dimensionless; default 100: a spring
+    /// stretched to 101 times its rest length). Zero-length springs are not checked.
+    pub max_spring_strain: f32,
+}
+
+impl Default for DivergenceGuard {
+    fn default() -> Self {
+        Self {
+            max_speed: 1e4,
+            max_spring_strain: 100.0,
+        }
+    }
+}
+
+impl DivergenceGuard {
+    /// The hot loops' check folds speed into their finiteness probe, `(x + v s) · 0`, which
+    /// is NaN when anything is non-finite or when v s overflows: s = f32::MAX / (max_speed/√3)
+    /// makes any axis faster than max_speed/√3 overflow (so every body faster than
+    /// max_speed does), at no cost beyond the multiply. A hit is then checked exactly.
+    #[must_use]
+    #[inline]
+    pub(crate) fn overflow_scale(&self) -> f32 {
+        let trigger = self.max_speed / 3f32.sqrt();
+        if trigger.is_finite() && trigger > 0.0 {
+            f32::MAX / trigger
+        } else {
+            0.0
+        }
+    }
+
+    /// The reason for a finite body moving at `v`, if it diverged.
+    #[must_use]
+    pub(crate) fn check(&self, v: glam::Vec3A, node: Option<u32>) -> Option<QuarantineReason> {
+        let speed = v.length();
+        (speed > self.max_speed).then_some(QuarantineReason::Diverged { speed, node })
+    }
 }
 
 /// Marks a body that is no longer simulated. See the module docs.

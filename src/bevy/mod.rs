@@ -124,6 +124,7 @@ fn register_messages(world: &mut World) {
     MessageRegistry::register_message::<ContactStarted>(world);
     MessageRegistry::register_message::<ContactEnded>(world);
     MessageRegistry::register_message::<BodyQuarantined>(world);
+    MessageRegistry::register_message::<crate::StabilityWarning>(world);
     world.insert_resource(MessagesRegistered);
 }
 

@@ -34,6 +34,7 @@ mod plugin;
 pub(crate) mod skyline;
 mod stages;
 
+pub(crate) use plugin::mesh_divergence;
 pub use plugin::{ConstraintsActive, IntegratorPlugin};
 
 /// Meshes the explicit integrators advance: alive, awake, and not solved implicitly.

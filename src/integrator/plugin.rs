@@ -8,7 +8,7 @@ use crate::particles::{
     ExternalForce, ExternalImpulse, Force, Gravity, GravityScale, LinearVelocity, Mass, Nodes,
     Position,
 };
-use crate::quarantine::{Quarantined, quarantine_non_finite};
+use crate::quarantine::{DivergenceGuard, QuarantineReason, Quarantined, quarantine_non_finite};
 use crate::rigid::{
     AngularMomentum, CenterOfMass, ExternalImpulseAtPoint, ExternalTorque, Inertia, Rotation,
     Torque, world_point,
@@ -190,6 +190,7 @@ type BodyState<'a> = (
 #[allow(clippy::type_complexity)] // a ParamSet of queries; naming each adds nothing
 fn integrate_velocities(
     mut commands: Commands,
+    guard: Res<DivergenceGuard>,
     global: Res<Integrator>,
     constraints: Res<ConstraintsActive>,
     time: Res<SubstepTime>,
@@ -205,15 +206,28 @@ fn integrate_velocities(
     if constraints.fuses(method) {
         // Both halves of symplectic Euler in one pass; see `ConstraintsActive`.
         let mut probe = Vec3A::ZERO;
-        set.p0().iter_mut().for_each(|(mut x, mut v, f, m)| {
-            let va = kick(v.0, f.0 * m.inverse(), h);
-            let xa = drift(x.0, va, h);
-            probe += (xa + va) * 0.0;
-            v.0 = va;
-            x.0 = xa;
-        });
+        // Speed is checked in the step's last substep only: the multiply costs 6% of this
+        // loop, and a divergence is still caught in the step it happens.
+        if time.index + 1 >= time.count {
+            let s = guard.overflow_scale();
+            set.p0().iter_mut().for_each(|(mut x, mut v, f, m)| {
+                let va = kick(v.0, f.0 * m.inverse(), h);
+                let xa = drift(x.0, va, h);
+                probe += (xa + va * s) * 0.0;
+                v.0 = va;
+                x.0 = xa;
+            });
+        } else {
+            set.p0().iter_mut().for_each(|(mut x, mut v, f, m)| {
+                let va = kick(v.0, f.0 * m.inverse(), h);
+                let xa = drift(x.0, va, h);
+                probe += (xa + va) * 0.0;
+                v.0 = va;
+                x.0 = xa;
+            });
+        }
         if probe != Vec3A::ZERO {
-            quarantine_suspects(&mut commands, &set.p2());
+            quarantine_suspects(&mut commands, &set.p2(), &guard);
         }
     } else if method == Integrator::SymplecticEuler {
         set.p0().iter_mut().for_each(|(_, mut v, f, m)| {
@@ -260,17 +274,43 @@ type Drift<'a> = (&'a mut Position, &'a LinearVelocity);
 type Suspects<'w, 's> =
     Query<'w, 's, (Entity, &'static Position, &'static LinearVelocity), (With<Mass>, Live)>;
 
-fn quarantine_suspects(commands: &mut Commands, suspects: &Suspects) {
+fn quarantine_suspects(commands: &mut Commands, suspects: &Suspects, guard: &DivergenceGuard) {
     for (e, x, v) in suspects {
         if !(x.0.is_finite() && v.0.is_finite()) {
             quarantine_non_finite(commands, e);
+        } else if let Some(reason) = guard.check(v.0, None) {
+            commands.entity(e).insert(Quarantined { reason });
         }
     }
+}
+
+/// A mesh whose nodes' probe found a non-finite lane or a fast axis: quarantined if it is
+/// non-finite or its fastest node diverged.
+fn check_mesh(commands: &mut Commands, e: Entity, n: &Nodes, guard: &DivergenceGuard) {
+    if !n.is_finite() {
+        quarantine_non_finite(commands, e);
+    } else if let Some(reason) = mesh_divergence(n, guard) {
+        commands.entity(e).insert(Quarantined { reason });
+    }
+}
+
+/// Why a finite mesh counts as diverged: its fastest node is past the guard.
+#[must_use]
+pub(crate) fn mesh_divergence(n: &Nodes, guard: &DivergenceGuard) -> Option<QuarantineReason> {
+    let (i, _) =
+        n.v.iter()
+            .enumerate()
+            .fold((0, 0.0f32), |(bi, bs), (i, v)| {
+                let s = v.length_squared();
+                if s > bs { (i, s) } else { (bi, bs) }
+            });
+    guard.check(*n.v.get(i)?, Some(i as u32))
 }
 
 #[allow(clippy::type_complexity)] // a ParamSet of queries; naming each adds nothing
 fn integrate_positions(
     mut commands: Commands,
+    guard: Res<DivergenceGuard>,
     global: Res<Integrator>,
     constraints: Res<ConstraintsActive>,
     time: Res<SubstepTime>,
@@ -285,7 +325,14 @@ fn integrate_positions(
     let method = *global;
     // 0·x + 0·v stays zero unless a lane is NaN or infinite: a branch-free finiteness
     // check that keeps the loop vectorised.
+    // Speed folded into the finiteness probe (see `DivergenceGuard::overflow_scale`).
     let mut probe = Vec3A::ZERO;
+    // In the step's last substep only (see `integrate_velocities`).
+    let s = if time.index + 1 >= time.count {
+        guard.overflow_scale()
+    } else {
+        0.0
+    };
     if constraints.fuses(method) {
         // Done in the velocity pass.
     } else if matches!(
@@ -295,7 +342,7 @@ fn integrate_positions(
         bodies.p0().iter_mut().for_each(|(mut x, v)| {
             let (xa, va) = (x.0, v.0);
             let xa = drift(xa, va, h);
-            probe += (xa + va) * 0.0;
+            probe += (xa + va * s) * 0.0;
             x.0 = xa;
         });
     } else if method == Integrator::ExplicitEuler {
@@ -303,7 +350,7 @@ fn integrate_positions(
         bodies
             .p0()
             .iter()
-            .for_each(|(x, v)| probe += (x.0 + v.0) * 0.0);
+            .for_each(|(x, v)| probe += (x.0 + v.0 * s) * 0.0);
     }
     bodies.p1().iter_mut().for_each(|((mut x, v), o)| {
         if matches!(
@@ -312,10 +359,10 @@ fn integrate_positions(
         ) {
             x.0 = drift(x.0, v.0, h);
         }
-        probe += (x.0 + v.0) * 0.0;
+        probe += (x.0 + v.0 * s) * 0.0;
     });
     if probe != Vec3A::ZERO {
-        quarantine_suspects(&mut commands, &bodies.p2());
+        quarantine_suspects(&mut commands, &bodies.p2(), &guard);
     }
     for (e, mut nodes, o) in &mut meshes {
         let method = o.map_or(method, |o| o.0);
@@ -323,10 +370,10 @@ fn integrate_positions(
         let mut probe = Vec3A::ZERO;
         for (x, v) in n.x.iter_mut().zip(&n.v) {
             position_phase(method, x, *v, h);
-            probe += (*x + *v) * 0.0;
+            probe += (*x + *v * s) * 0.0;
         }
         if probe != Vec3A::ZERO {
-            quarantine_non_finite(&mut commands, e);
+            check_mesh(&mut commands, e, n, &guard);
         }
     }
 }

@@ -280,34 +280,42 @@ pub(crate) fn complete_stages(
         }
     }
 
-    // RK4 bodies skipped the position phase, so check them here.
+    // RK4 bodies skipped the position phase, so check them here (non-finite, or faster than
+    // the divergence guard allows).
+    let guard = world
+        .get_resource::<crate::quarantine::DivergenceGuard>()
+        .copied()
+        .unwrap_or_default();
     let mut bad = Vec::new();
     for (e, _) in &s.bodies {
-        if let Ok((_, x, v, ..)) = bodies.get(world, *e)
-            && !(x.0.is_finite() && v.0.is_finite())
-        {
-            bad.push(*e);
+        if let Ok((_, x, v, ..)) = bodies.get(world, *e) {
+            if !(x.0.is_finite() && v.0.is_finite()) {
+                bad.push((*e, QuarantineReason::NonFiniteState));
+            } else if let Some(reason) = guard.check(v.0, None) {
+                bad.push((*e, reason));
+            }
         }
     }
     for (e, method, _) in &s.meshes {
         if *method == Integrator::Rk4
             && let Ok((_, nodes, _)) = meshes.get(world, *e)
-            && !nodes.is_finite()
         {
-            bad.push(*e);
+            if !nodes.is_finite() {
+                bad.push((*e, QuarantineReason::NonFiniteState));
+            } else if let Some(reason) = super::plugin::mesh_divergence(nodes, &guard) {
+                bad.push((*e, reason));
+            }
         }
     }
     for (e, ..) in &s.rotations {
         if let Ok((_, q, l, ..)) = rotations.get(world, *e)
             && !(q.0.is_finite() && l.0.is_finite())
         {
-            bad.push(*e);
+            bad.push((*e, QuarantineReason::NonFiniteState));
         }
     }
-    for e in bad {
-        world.entity_mut(e).insert(Quarantined {
-            reason: QuarantineReason::NonFiniteState,
-        });
+    for (e, reason) in bad {
+        world.entity_mut(e).insert(Quarantined { reason });
     }
 }
 

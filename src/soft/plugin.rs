@@ -99,6 +99,7 @@ fn apply_elastic_forces(
 /// quarantined.
 fn solve_implicit(
     mut commands: Commands,
+    guard: Res<crate::quarantine::DivergenceGuard>,
     time: Res<SubstepTime>,
     mut bodies: Query<
         (
@@ -122,7 +123,13 @@ fn solve_implicit(
             time.h,
             &mut scratch,
         ) {
-            Some(report) => body.stats.implicit = report,
+            Some(report) => {
+                body.stats.implicit = report;
+                // Backward Euler does not diverge, but a bad input can still fling nodes.
+                if let Some(reason) = crate::integrator::mesh_divergence(&nodes, &guard) {
+                    commands.entity(e).insert(Quarantined { reason });
+                }
+            }
             None => {
                 commands.entity(e).insert(Quarantined {
                     reason: QuarantineReason::NonFiniteState,

@@ -32,10 +32,12 @@
 
 mod builders;
 mod plugin;
+pub mod stability;
 
 pub use builders::{Chain, ChainBuilder, ClothBuilder};
 pub use plugin::SpringPlugin;
 pub(crate) use plugin::{Endpoint, Spinning, anchor_state};
+pub use stability::{EntitySpringStability, SpringStability, StabilityWarning};
 
 use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
@@ -219,6 +221,7 @@ fn validate_spring(mut world: DeferredWorld, ctx: HookContext) {
 
 /// Springs between the [`Nodes`] of the same entity, as parallel arrays (Hooke form).
 #[derive(Component, Debug, Clone, Default, PartialEq)]
+#[require(SpringStability)]
 pub struct SpringNetwork {
     pub(crate) ends: Vec<[u32; 2]>,
     pub(crate) rest: Vec<f32>,

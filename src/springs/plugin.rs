@@ -32,11 +32,18 @@ impl WorldPlugin for SpringPlugin {
                 .chain()
                 .in_set(ForceSystems::Springs)
         });
+        world.init_resource::<super::EntitySpringStability>();
+        world.init_resource::<bevy_ecs::message::Messages<super::StabilityWarning>>();
         add_systems(
             world,
             PhysicsSchedule,
-            remove_broken_springs
-                .run_if(any_with_component::<Spring>)
+            (
+                remove_broken_springs.run_if(any_with_component::<Spring>),
+                super::stability::check_stability.run_if(
+                    any_with_component::<Spring>.or_else(any_with_component::<SpringNetwork>),
+                ),
+            )
+                .chain()
                 .in_set(PrepareSystems::Inputs),
         );
     }
@@ -69,14 +76,18 @@ pub(crate) fn anchor_state(
     }
 }
 
+#[allow(clippy::too_many_arguments)] // a system: each argument is one query or resource it reads
 fn apply_spring_forces(
-    springs: Query<&Spring, Live>,
+    mut commands: Commands,
+    guard: Res<crate::quarantine::DivergenceGuard>,
+    springs: Query<(Entity, &Spring), Live>,
     states: Query<Endpoint, Live>,
     spinning: Query<Spinning, Live>,
     mut forces: Query<&mut Force, Live>,
     mut torques: Query<&mut Torque, Live>,
+    masses: Query<&crate::particles::Mass>,
 ) {
-    for s in &springs {
+    for (spring, s) in &springs {
         // A quarantined or missing endpoint drops out of the query, so NaN can't cross.
         let (Ok(ea), Ok(eb)) = (states.get(s.a), states.get(s.b)) else {
             continue;
@@ -92,7 +103,31 @@ fn apply_spring_forces(
         let (pa, va, ra) = anchor_state(ea, spin(s.a, s.anchor_a), s.anchor_a);
         let (pb, vb, rb) = anchor_state(eb, spin(s.b, s.anchor_b), s.anchor_b);
         let f = spring_force(pa, pb, va, vb, s.rest_length, s.stiffness, s.damping);
-        if !f.is_finite() {
+        // A force past the guard's strain (|f| > k r s_max, damping included) or not finite
+        // means the integration diverged: both ends leave, with the spring named, instead
+        // of the force being dropped silently.
+        let limit = s.stiffness * s.rest_length * guard.max_spring_strain;
+        let ends_finite = pa.is_finite() && pb.is_finite() && va.is_finite() && vb.is_finite();
+        if !ends_finite {
+            // A non-finite end (written by game code, say) is caught and named by the state
+            // check after integration; its neighbours must not catch its NaN meanwhile.
+            continue;
+        }
+        if !f.is_finite() || (s.rest_length > 0.0 && f.length_squared() > limit * limit) {
+            let strain = if f.is_finite() {
+                ((pb - pa).length() - s.rest_length) / s.rest_length
+            } else {
+                f32::NAN
+            };
+            // A pinned end (a hook in the ceiling) did not diverge and stays.
+            for end in [s.a, s.b]
+                .into_iter()
+                .filter(|&e| masses.get(e).is_ok_and(|m| !m.is_pinned()))
+            {
+                commands.entity(end).insert(Quarantined {
+                    reason: QuarantineReason::SpringFailed { spring, strain },
+                });
+            }
             continue;
         }
         if let Ok(mut fa) = forces.get_mut(s.a) {
