@@ -30,10 +30,12 @@
 //! an oscillator; measure at a time that is not a multiple of the period (the tests use
 //! t = 0.3 s for a 1 s period).
 
+pub(crate) mod implicit;
 mod plugin;
 pub(crate) mod skyline;
 mod stages;
 
+pub use implicit::ImplicitReport;
 pub(crate) use plugin::mesh_divergence;
 pub use plugin::{ConstraintsActive, IntegratorPlugin};
 

@@ -1,182 +1,17 @@
-//! Backward Euler for soft bodies: Newton on the incremental potential with a matrix-free,
-//! Jacobi-preconditioned conjugate-gradient solve (see [`crate::ImplicitEuler`]).
-//!
-//! For a substep h, with y = x₀ + h v₀ and D = α M + β K₀ (Rayleigh damping, K₀ the projected
-//! stiffness at the step's first iterate):
-//!
-//! ```text
-//! E(x) = ½ (x − y)ᵀ M (x − y) / h² + U(x) − f_extᵀ x + ½ (x − x₀)ᵀ D (x − x₀) / h
-//! g(x) = M (x − y) / h² + ∇U(x) − f_ext + D (x − x₀) / h
-//! H(x) = M / h² + K(x) + D / h,        K = Σₑ Vₑ Bₑᵀ [∂P/∂F]₊ Bₑ
-//! ```
-//!
-//! [∂P/∂F]₊ is the element's 9 × 9 stress derivative with its negative eigenvalues set to
-//! zero, so H is positive definite and each Newton direction descends E; a backtracking line
-//! search on E then makes every step lower the potential, which is what makes the scheme
-//! stable at any stiffness and step.
+//! The soft body's side of the backward-Euler solve ([`crate::integrator::implicit`]): its
+//! tetrahedra as [`ImplicitElements`]. An element's matrix is its 9 × 9 ∂P/∂F (column-major
+//! vec of F); its stiffness is K_k = V Bᵀ [∂P/∂F] B with dF = Σ_b dx_b b_bᵀ, and its damping
+//! the Rayleigh β K₀ of the projected stiffness at the step's start.
 
 // Parallel arrays (positions, masses, gradients) are walked by one index together.
 #![allow(clippy::needless_range_loop)]
 
-use glam::{DMat3, DVec3, Mat3, Vec3, Vec3A};
+use glam::{DMat3, DVec3, Mat3, Vec3A};
 use nalgebra::{SMatrix, SVector};
 
 use super::SoftBody;
 use super::strain::Prepared;
-use crate::integrator::skyline::SkylineCholesky;
-use crate::integrator::{ImplicitEuler, ImplicitState};
-use crate::particles::Nodes;
-
-/// What one implicit substep did.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ImplicitReport {
-    /// Newton iterations taken.
-    pub newton_iterations: u32,
-    /// Conjugate-gradient iterations, summed over the Newton iterations.
-    pub cg_iterations: u32,
-    /// ‖g‖ at the end over ‖g‖ at the start (0 when the start was already at rest).
-    pub residual: f32,
-}
-
-/// Buffers kept between substeps, so a step allocates nothing once warm. The linear algebra
-/// runs in f64: a beam's stiffness matrix is ill-conditioned enough that f32 conjugate
-/// gradients stall at a relative residual of about 1e-2.
-#[derive(Default)]
-pub(crate) struct Scratch {
-    x0: Vec<Vec3A>,
-    y: Vec<Vec3A>,
-    trial: Vec<Vec3A>,
-    elastic: Vec<Vec3A>,
-    zero: Vec<Vec3A>,
-    g: Vec<DVec3>,
-    dx: Vec<DVec3>,
-    r: Vec<DVec3>,
-    z: Vec<DVec3>,
-    p: Vec<DVec3>,
-    q: Vec<DVec3>,
-    diag: Vec<DVec3>,
-    d: Vec<DVec3>,
-    kd: Vec<DVec3>,
-    /// ∂P/∂F per element at the current iterate, as is and projected; the projected one at
-    /// the first iterate (for D).
-    raw: Vec<[f64; 81]>,
-    hess: Vec<[f64; 81]>,
-    hess0: Vec<[f64; 81]>,
-    /// Per node, whether it moves (not pinned).
-    free: Vec<bool>,
-    /// Per node, the normal of a contact holding it (zero for none).
-    filter: Vec<DVec3>,
-    /// Whether any element is indefinite this iteration, which ones, and whether `hess`
-    /// holds this iteration's projections yet.
-    indefinite: bool,
-    negative: Vec<bool>,
-    projected: bool,
-    /// The factor's triangular-solve buffer.
-    work: Vec<f64>,
-    /// The elements decomposed at the current iterate and at the line search's trial, and
-    /// their P.
-    prep: Vec<Prepared>,
-    prep_trial: Vec<Prepared>,
-    piola: Vec<Mat3>,
-    piola_trial: Vec<Mat3>,
-}
-
-/// `s.hess` ← the projections of `s.raw` (once per Newton iteration).
-fn project_hessians(s: &mut Scratch) {
-    if s.projected {
-        return;
-    }
-    for k in 0..s.raw.len() {
-        s.hess[k] = if s.negative[k] {
-            project(&s.raw[k])
-        } else {
-            s.raw[k]
-        };
-    }
-    s.projected = true;
-}
-
-/// Builds (once per mesh) the factor's envelope, and asks for a new factor when h changed.
-fn prepare_factor(
-    body: &SoftBody,
-    settings: &ImplicitEuler,
-    state: &mut ImplicitState,
-    len: usize,
-    h: f32,
-) {
-    let key = (len, body.tets.len());
-    if state.built_for != Some(key) {
-        state.built_for = Some(key);
-        state.factor = None;
-        if settings.max_factor_entries > 0 {
-            let mut adjacency = vec![Vec::new(); len];
-            for t in &body.tets {
-                for &a in t {
-                    adjacency[a as usize].extend_from_slice(t);
-                }
-            }
-            for list in &mut adjacency {
-                list.sort_unstable();
-                list.dedup();
-            }
-            state.factor = SkylineCholesky::new(&adjacency, settings.max_factor_entries);
-        }
-    }
-    if state.h != h {
-        state.h = h;
-        state.refactor = true;
-    }
-}
-
-/// The factor to precondition this solve with: renewed from H (`hess` elements, D from
-/// `s.hess0`) when asked for or when none is held; None (Jacobi) when the body has no
-/// envelope or H is not positive definite.
-#[allow(clippy::too_many_arguments)] // the solve's whole state, passed once per Newton step
-fn refresh_factor<'a>(
-    body: &SoftBody,
-    n: &Nodes,
-    s: &Scratch,
-    state: &'a mut ImplicitState,
-    hess: &[[f64; 81]],
-    free: &[bool],
-    hd: f64,
-    alpha: f64,
-    beta: f64,
-) -> Option<&'a SkylineCholesky> {
-    let renew = state.refactor || !state.factor.as_ref()?.is_factored();
-    let factor = state.factor.as_mut()?;
-    if renew {
-        state.refactor = false;
-        let mass_term = |m: f32| f64::from(m) * (1.0 / (hd * hd) + alpha / hd);
-        factor.factor(|add| {
-            for i in 0..free.len() {
-                // A pinned node's row is the identity times a mass-like scale, so the
-                // factor stays well conditioned; its unknowns are zero anyway.
-                let m = mass_term(n.mass[i]).max(1.0);
-                add(i as u32, i as u32, DMat3::from_diagonal(DVec3::splat(m)));
-            }
-            let mut element = |k: usize, t: &[u32; 4], h: &[f64; 81], scale: f64| {
-                let b = gradients(body.dm_inv[k].as_dmat3());
-                let blocks = element_blocks(&b, h, scale * f64::from(body.volume[k]));
-                for a in 0..4 {
-                    for c in 0..4 {
-                        let (i, j) = (t[a] as usize, t[c] as usize);
-                        if free[i] && free[j] {
-                            add(t[a], t[c], blocks[a][c]);
-                        }
-                    }
-                }
-            };
-            for (k, t) in body.tets.iter().enumerate() {
-                element(k, t, &hess[k], 1.0);
-                if beta > 0.0 {
-                    element(k, t, &s.hess0[k], beta / hd);
-                }
-            }
-        });
-    }
-    factor.is_factored().then_some(&*factor)
-}
+use crate::integrator::implicit::{ContactPlane, ImplicitElements};
 
 type M9 = SMatrix<f64, 9, 9>;
 
@@ -259,26 +94,72 @@ fn gradients(dm_inv: DMat3) -> [DVec3; 4] {
     [-(b1 + b2 + b3), b1, b2, b3]
 }
 
-/// out += scale · K dx with K from the per-element 9 × 9 matrices `hess`.
-fn add_stiffness(body: &SoftBody, hess: &[[f64; 81]], dx: &[DVec3], scale: f64, out: &mut [DVec3]) {
-    for (k, t) in body.tets.iter().enumerate() {
-        let dm_inv = body.dm_inv[k].as_dmat3();
+impl ImplicitElements for SoftBody {
+    type Hess = [f64; 81];
+    type Prep = (Prepared, Mat3);
+
+    fn count(&self) -> usize {
+        self.tets.len()
+    }
+
+    fn zero() -> Self::Hess {
+        [0.0; 81]
+    }
+
+    fn nodes(&self, k: usize) -> &[u32] {
+        &self.tets[k]
+    }
+
+    fn mass_damping(&self) -> f64 {
+        f64::from(self.material.damping().0)
+    }
+
+    fn has_damping(&self) -> bool {
+        self.material.damping().1 > 0.0
+    }
+
+    fn planes(&self) -> &[ContactPlane] {
+        &self.contacts
+    }
+
+    fn prepare(&self, x: &[Vec3A], prep: &mut Vec<Self::Prep>) -> f64 {
+        prepare_elements(self, x, prep)
+    }
+
+    fn forces(&self, prep: &[Self::Prep], out: &mut [Vec3A]) -> bool {
+        elastic_from(self, prep, out)
+    }
+
+    fn hessian(&self, _k: usize, prep: &Self::Prep) -> (Self::Hess, bool) {
+        element_hessian(self, &prep.0)
+    }
+
+    fn project(h: &Self::Hess) -> Self::Hess {
+        project(h)
+    }
+
+    fn damping(&self, _k: usize, _prep: &Self::Prep, projected: &Self::Hess) -> Option<Self::Hess> {
+        let beta = f64::from(self.material.damping().1);
+        (beta > 0.0).then(|| projected.map(|v| beta * v))
+    }
+
+    fn apply(&self, k: usize, h: &Self::Hess, dx: &[DVec3], scale: f64, out: &mut [DVec3]) {
+        let t = self.tets[k];
+        let dm_inv = self.dm_inv[k].as_dmat3();
         let d = |i: usize| dx[t[i] as usize] - dx[t[0] as usize];
         let df = DMat3::from_cols(d(1), d(2), d(3)) * dm_inv;
-        let dp = DMat3::from_cols_array(&mul9(&hess[k], vec9(df)));
-        let h = (scale * f64::from(body.volume[k])) * dp * dm_inv.transpose();
-        out[t[1] as usize] += h.x_axis;
-        out[t[2] as usize] += h.y_axis;
-        out[t[3] as usize] += h.z_axis;
-        out[t[0] as usize] -= h.x_axis + h.y_axis + h.z_axis;
+        let dp = DMat3::from_cols_array(&mul9(h, vec9(df)));
+        let f = (scale * f64::from(self.volume[k])) * dp * dm_inv.transpose();
+        out[t[1] as usize] += f.x_axis;
+        out[t[2] as usize] += f.y_axis;
+        out[t[3] as usize] += f.z_axis;
+        out[t[0] as usize] -= f.x_axis + f.y_axis + f.z_axis;
     }
-}
 
-/// out += scale · diag(K), for the Jacobi preconditioner.
-fn add_stiffness_diagonal(body: &SoftBody, hess: &[[f64; 81]], scale: f64, out: &mut [DVec3]) {
-    for (k, t) in body.tets.iter().enumerate() {
-        let b = gradients(body.dm_inv[k].as_dmat3());
-        let vol = scale * f64::from(body.volume[k]);
+    fn add_diagonal(&self, k: usize, h: &Self::Hess, scale: f64, out: &mut [DVec3]) {
+        let t = self.tets[k];
+        let b = gradients(self.dm_inv[k].as_dmat3());
+        let vol = scale * f64::from(self.volume[k]);
         for (a, &node) in t.iter().enumerate() {
             let mut d = [0.0f64; 3];
             for (c, slot) in d.iter_mut().enumerate() {
@@ -288,88 +169,51 @@ fn add_stiffness_diagonal(body: &SoftBody, hess: &[[f64; 81]], scale: f64, out: 
                 e.y_axis[c] = b[a].y;
                 e.z_axis[c] = b[a].z;
                 let v = vec9(e);
-                let hv = mul9(&hess[k], v);
+                let hv = mul9(h, v);
                 *slot = vol * v.iter().zip(hv).map(|(x, y)| x * y).sum::<f64>();
             }
             out[node as usize] += DVec3::from_array(d);
         }
     }
-}
 
-fn dot(a: &[DVec3], b: &[DVec3]) -> f64 {
-    a.iter().zip(b).map(|(x, y)| x.dot(*y)).sum()
-}
-
-fn d3(v: Vec3A) -> DVec3 {
-    Vec3::from(v).as_dvec3()
-}
-
-/// The incremental potential E(x) (J) but its elastic part (see [`prepare_elements`]), without
-/// the constant terms.
-fn potential_rest(
-    body: &SoftBody,
-    n: &Nodes,
-    s: &mut Scratch,
-    x: &[Vec3A],
-    h: f64,
-    alpha: f64,
-    beta: f64,
-) -> f64 {
-    let mut e = 0.0f64;
-    let inv_h2 = 1.0 / (h * h);
-    for i in 0..x.len() {
-        if n.inv_mass[i] == 0.0 {
-            continue;
+    fn blocks(&self, k: usize, h: &Self::Hess, scale: f64, add: &mut dyn FnMut(u32, u32, DMat3)) {
+        let t = self.tets[k];
+        let b = gradients(self.dm_inv[k].as_dmat3());
+        let blocks = element_blocks(&b, h, scale * f64::from(self.volume[k]));
+        for a in 0..4 {
+            for c in 0..4 {
+                add(t[a], t[c], blocks[a][c]);
+            }
         }
-        let m = f64::from(n.mass[i]);
-        let (xi, yi, x0) = (d3(x[i]), d3(s.y[i]), d3(s.x0[i]));
-        e += 0.5 * m * inv_h2 * (xi - yi).length_squared()
-            + 0.5 * alpha * m / h * (xi - x0).length_squared()
-            - d3(n.f[i]).dot(xi);
     }
-    if beta > 0.0 {
-        // ½ β/h (x − x₀)ᵀ K₀ (x − x₀)
-        for i in 0..x.len() {
-            s.d[i] = d3(x[i]) - d3(s.x0[i]);
-            s.kd[i] = DVec3::ZERO;
-        }
-        let (d, mut kd) = (std::mem::take(&mut s.d), std::mem::take(&mut s.kd));
-        add_stiffness(body, &s.hess0, &d, 1.0, &mut kd);
-        e += 0.5 * beta / h * dot(&d, &kd);
-        (s.d, s.kd) = (d, kd);
+
+    fn finish(&mut self, prep: &[Self::Prep], energy: f64) {
+        record_stats(self, prep, energy);
     }
-    e
 }
 
 /// Decomposes every element at positions `x` (once per iterate: for the co-rotated model
 /// the polar decomposition is the solve's dominant cost) into `prep`, its P into `piola`;
 /// returns the elastic energy Σ V Ψ (J).
-fn prepare_elements(
-    body: &SoftBody,
-    x: &[Vec3A],
-    prep: &mut Vec<Prepared>,
-    piola: &mut Vec<Mat3>,
-) -> f64 {
+fn prepare_elements(body: &SoftBody, x: &[Vec3A], prep: &mut Vec<(Prepared, Mat3)>) -> f64 {
     prep.clear();
-    piola.clear();
     let mut e = 0.0f64;
     for k in 0..body.tets.len() {
         let f = body.deformation_gradient(x, k);
         let p = Prepared::new(body.model, f, body.lame);
         let stress = p.stress(body.model, body.lame);
         e += f64::from(body.volume[k]) * f64::from(stress.energy);
-        prep.push(p);
-        piola.push(stress.piola);
+        prep.push((p, stress.piola));
     }
     e
 }
 
 /// The elastic forces −V P Dm⁻ᵀ of the prepared elements into `out`; false if non-finite.
-fn elastic_from(body: &SoftBody, piola: &[Mat3], out: &mut [Vec3A]) -> bool {
+fn elastic_from(body: &SoftBody, prep: &[(Prepared, Mat3)], out: &mut [Vec3A]) -> bool {
     out.iter_mut().for_each(|f| *f = Vec3A::ZERO);
     let mut finite = true;
     for (k, t) in body.tets.iter().enumerate() {
-        let h = -body.volume[k] * piola[k] * body.dm_inv[k].transpose();
+        let h = -body.volume[k] * prep[k].1 * body.dm_inv[k].transpose();
         finite &= h.is_finite();
         super::scatter_element_forces(out, *t, h);
     }
@@ -377,10 +221,10 @@ fn elastic_from(body: &SoftBody, piola: &[Mat3], out: &mut [Vec3A]) -> bool {
 }
 
 /// The body's stats (energy, volume ratio, inverted count) from the prepared elements.
-fn record_stats(body: &mut SoftBody, prep: &[Prepared], elastic: f64) {
+fn record_stats(body: &mut SoftBody, prep: &[(Prepared, Mat3)], elastic: f64) {
     let (mut vj, mut vsum, mut inverted) = (0.0f64, 0.0f64, 0usize);
     for (p, &vol) in prep.iter().zip(&body.volume) {
-        let j = p.deformation().determinant();
+        let j = p.0.deformation().determinant();
         inverted += usize::from(j <= 0.0);
         vj += f64::from(vol) * f64::from(j);
         vsum += f64::from(vol);
@@ -390,378 +234,11 @@ fn record_stats(body: &mut SoftBody, prep: &[Prepared], elastic: f64) {
     body.stats.inverted = inverted;
 }
 
-/// One backward-Euler substep of length `h` for `body`'s nodes. `n.f` holds the step's
-/// constant forces (gravity, external, damping), not the elastic ones. Returns None if the
-/// state turned non-finite.
-pub(crate) fn step(
-    body: &mut SoftBody,
-    n: &mut Nodes,
-    settings: &ImplicitEuler,
-    state: &mut ImplicitState,
-    h: f32,
-    s: &mut Scratch,
-) -> Option<ImplicitReport> {
-    let len = n.x.len();
-    prepare_factor(body, settings, state, len, h);
-    let (alpha, beta) = body.material.damping();
-    let (alpha, beta, hd) = (f64::from(alpha), f64::from(beta), f64::from(h));
-    for buf in [
-        &mut s.x0,
-        &mut s.y,
-        &mut s.trial,
-        &mut s.elastic,
-        &mut s.zero,
-    ] {
-        buf.clear();
-        buf.resize(len, Vec3A::ZERO);
-    }
-    for buf in [
-        &mut s.g,
-        &mut s.dx,
-        &mut s.r,
-        &mut s.z,
-        &mut s.p,
-        &mut s.q,
-        &mut s.diag,
-        &mut s.d,
-        &mut s.kd,
-    ] {
-        buf.clear();
-        buf.resize(len, DVec3::ZERO);
-    }
-    s.x0.copy_from_slice(&n.x);
-    for i in 0..len {
-        s.y[i] = n.x[i] + h * n.v[i];
-    }
-    // The inertial predictor is the first iterate; pinned nodes stay there.
-    // Contacts found at the end of the last substep: planes n·x ≥ d the nodes may not cross.
-    clamp_to_contacts(&body.contacts, &mut s.y);
-    n.x.copy_from_slice(&s.y);
-    let mut free = std::mem::take(&mut s.free);
-    free.clear();
-    free.extend(n.inv_mass.iter().map(|&w| w != 0.0));
-    let inv_h2 = 1.0 / (hd * hd);
-    let mut report = ImplicitReport::default();
-    let (mut g0, mut previous) = (0.0f64, f64::INFINITY);
-    let mut clamped = false;
-    s.hess.resize(body.tets.len(), [0.0; 81]);
-    s.raw.resize(body.tets.len(), [0.0; 81]);
-    s.negative.resize(body.tets.len(), false);
-    let mut elastic_now = prepare_elements(body, &n.x, &mut s.prep, &mut s.piola);
-    for it in 0..settings.max_newton {
-        s.indefinite = false;
-        for k in 0..body.tets.len() {
-            let (raw, negative) = element_hessian(body, &s.prep[k]);
-            s.indefinite |= negative;
-            s.raw[k] = raw;
-            s.negative[k] = negative;
-        }
-        s.projected = false;
-        if it == 0 {
-            // D = α M + β K₀ must be positive semi-definite: K₀ from projected elements.
-            if beta > 0.0 {
-                project_hessians(s);
-                s.hess0.clone_from(&s.hess);
-            } else {
-                s.hess0.clear();
-            }
-        }
-        if !elastic_from(body, &s.piola, &mut s.elastic) {
-            return None;
-        }
-        for i in 0..len {
-            s.g[i] = if free[i] {
-                let m = f64::from(n.mass[i]);
-                m * inv_h2 * (d3(n.x[i]) - d3(s.y[i])) - d3(s.elastic[i]) - d3(n.f[i])
-                    + alpha * m / hd * (d3(n.x[i]) - d3(s.x0[i]))
-            } else {
-                DVec3::ZERO
-            };
-        }
-        if beta > 0.0 {
-            for i in 0..len {
-                s.d[i] = d3(n.x[i]) - d3(s.x0[i]);
-                s.kd[i] = DVec3::ZERO;
-            }
-            let (d, mut kd) = (std::mem::take(&mut s.d), std::mem::take(&mut s.kd));
-            add_stiffness(body, &s.hess0, &d, beta / hd, &mut kd);
-            for i in 0..len {
-                if free[i] {
-                    s.g[i] += kd[i];
-                }
-            }
-            (s.d, s.kd) = (d, kd);
-        }
-        // A node on its contact plane that the gradient pushes in is held there: the
-        // contact takes the normal part (Baraff and Witkin's filter). One pulled away is free.
-        s.filter.clear();
-        s.filter.resize(len, DVec3::ZERO);
-        for c in &body.contacts {
-            let i = c.node as usize;
-            let normal = c.normal.as_dvec3();
-            let on_plane =
-                f64::from(c.normal.dot(Vec3::from(n.x[i]))) <= f64::from(c.offset) + 1e-6;
-            if on_plane && s.g[i].dot(normal) > 0.0 {
-                s.filter[i] = normal;
-                let gn = s.g[i].dot(normal);
-                s.g[i] -= gn * normal;
-            }
-        }
-        let gnorm = dot(&s.g, &s.g).sqrt();
-        if !gnorm.is_finite() {
-            return None;
-        }
-        if it == 0 {
-            // The force scale of the step: the first gradient, or, for a body already at rest
-            // (where that is only rounding), its weight and momentum over h.
-            let mut load = 0.0f64;
-            for i in 0..len {
-                if free[i] {
-                    let momentum = f64::from(n.mass[i]) * d3(n.v[i]) / hd;
-                    load += (d3(n.f[i]).length() + momentum.length()).powi(2);
-                }
-            }
-            g0 = gnorm.max(load.sqrt());
-        }
-        report.residual = if g0 > 0.0 { (gnorm / g0) as f32 } else { 0.0 };
-        // Converged; or stalled at the floor that f32 positions set (near 1e-4 of the first
-        // gradient on a stiff body), where Newton can only shuffle rounding.
-        // (Or no progress at all: at rest on a stiff body the rounding floor can lie above
-        // 1e-2 of the scale.) A gradient that grew because the last step put nodes back on
-        // their contact planes is not a stall: the next Newton step answers the contact.
-        let stalled =
-            (gnorm > 0.5 * previous && gnorm < 1e-2 * g0) || (gnorm > 0.9 * previous && !clamped);
-        if g0 == 0.0 || gnorm <= f64::from(settings.tolerance) * g0 || stalled {
-            break;
-        }
-        previous = gnorm;
-        report.newton_iterations += 1;
-
-        // CG on H dx = −g, dx = 0 on pinned nodes. The element Hessians as they are first:
-        // the mass term usually keeps H positive definite, and the exact H converges
-        // quadratically where the projected one crawls. On negative curvature, again with
-        // the projected ones, which always descend.
-        let attempts: &[bool] = if s.indefinite {
-            &[false, true]
-        } else {
-            &[false]
-        };
-        for &projected in attempts {
-            if projected {
-                project_hessians(s);
-            }
-            let hess = if projected {
-                std::mem::take(&mut s.hess)
-            } else {
-                std::mem::take(&mut s.raw)
-            };
-            let factor = refresh_factor(body, n, s, state, &hess, &free, hd, alpha, beta);
-            let before = report.cg_iterations;
-            let ok = conjugate_gradients(
-                body,
-                n,
-                s,
-                &hess,
-                factor,
-                &free,
-                hd,
-                alpha,
-                beta,
-                settings,
-                &mut report,
-            );
-            // With a lagged factor, CG on an indefinite H need not meet its negative
-            // curvature and can return a direction that climbs E: that is a failure too.
-            let ok = ok && dot(&s.g, &s.dx) < 0.0;
-            if factor.is_some() && report.cg_iterations - before > settings.refactor_after {
-                state.refactor = true;
-            }
-            if projected {
-                s.hess = hess;
-            } else {
-                s.raw = hess;
-            }
-            if ok {
-                break;
-            }
-            // Negative curvature: the factor (if of the raw matrix) is no use for the
-            // projected one.
-            state.refactor = true;
-        }
-
-        // A correction below the resolution of f32 positions (a few ulps of the body's
-        // extent) is the last one that can change anything: take it and stop.
-        let scale = n.x.iter().fold(0.0f32, |m, x| m.max(x.abs().max_element()));
-        let resolution = 16.0 * f64::from(f32::EPSILON) * f64::from(scale.max(1e-3));
-        let last =
-            s.dx.iter()
-                .zip(&free)
-                .all(|(d, &f)| !f || d.abs().max_element() <= resolution);
-
-        // Backtracking line search on E.
-        let e_now = elastic_now + potential_rest(body, n, s, &n.x, hd, alpha, beta);
-        let slope = dot(&s.g, &s.dx);
-        let mut step = 1.0f64;
-        let mut accepted = false;
-        for _ in 0..12 {
-            let mut trial = std::mem::take(&mut s.trial);
-            for i in 0..len {
-                trial[i] = Vec3A::from((d3(n.x[i]) + step * s.dx[i]).as_vec3());
-            }
-            let elastic = prepare_elements(body, &trial, &mut s.prep_trial, &mut s.piola_trial);
-            let e_new = elastic + potential_rest(body, n, s, &trial, hd, alpha, beta);
-            s.trial = trial;
-            if e_new.is_finite() && e_new <= e_now + 1e-4 * step * slope {
-                accepted = true;
-                elastic_now = elastic;
-                break;
-            }
-            step *= 0.5;
-        }
-        if !accepted {
-            break;
-        }
-        std::mem::swap(&mut s.prep, &mut s.prep_trial);
-        std::mem::swap(&mut s.piola, &mut s.piola_trial);
-        let moved = clamp_to_contacts(&body.contacts, &mut s.trial);
-        clamped = moved;
-        n.x.copy_from_slice(&s.trial);
-        if moved {
-            elastic_now = prepare_elements(body, &n.x, &mut s.prep, &mut s.piola);
-        }
-        if last {
-            break;
-        }
-    }
-    for i in 0..len {
-        n.v[i] = (n.x[i] - s.x0[i]) / h;
-    }
-    s.free = free;
-    // Stats at the end state, whose elements the last accepted trial prepared.
-    record_stats(body, &s.prep, elastic_now);
-    (elastic_now.is_finite() && n.x.iter().all(|x| x.is_finite())).then_some(report)
-}
-
-/// CG on H dx = −g with the element matrices `hess` (and D from `s.hess0`, K₀'s); false if it met
-/// negative curvature.
-#[allow(clippy::too_many_arguments)] // the solve's whole state, passed once per Newton step
-fn conjugate_gradients(
-    body: &SoftBody,
-    n: &Nodes,
-    s: &mut Scratch,
-    hess: &[[f64; 81]],
-    factor: Option<&SkylineCholesky>,
-    free: &[bool],
-    hd: f64,
-    alpha: f64,
-    beta: f64,
-    settings: &ImplicitEuler,
-    report: &mut ImplicitReport,
-) -> bool {
-    let len = n.x.len();
-    let mass_term = |m: f32| f64::from(m) * (1.0 / (hd * hd) + alpha / hd);
-    let precondition = |r: DVec3, d: DVec3| r / d.max(DVec3::splat(f64::MIN_POSITIVE));
-    // Jacobi preconditioner, diag(H), when there is no factor.
-    if factor.is_none() {
-        for i in 0..len {
-            s.diag[i] = DVec3::splat(mass_term(n.mass[i]));
-        }
-        add_stiffness_diagonal(body, hess, 1.0, &mut s.diag);
-        if beta > 0.0 {
-            add_stiffness_diagonal(body, &s.hess0, beta / hd, &mut s.diag);
-        }
-    }
-    // z = S P⁻¹ S r, S the contact filter (symmetric, so CG still applies).
-    let apply = |s: &mut Scratch| {
-        if let Some(factor) = factor {
-            for i in 0..len {
-                s.q[i] = filtered(s.r[i], s.filter[i]);
-            }
-            let mut work = std::mem::take(&mut s.work);
-            factor.solve(&s.q, &mut s.z, &mut work);
-            s.work = work;
-            for i in 0..len {
-                s.z[i] = if free[i] {
-                    filtered(s.z[i], s.filter[i])
-                } else {
-                    DVec3::ZERO
-                };
-            }
-        } else {
-            for i in 0..len {
-                s.z[i] = filtered(precondition(s.r[i], s.diag[i]), s.filter[i]);
-            }
-        }
-    };
-    for i in 0..len {
-        s.dx[i] = DVec3::ZERO;
-        s.r[i] = -s.g[i];
-    }
-    apply(s);
-    s.p.copy_from_slice(&s.z);
-    let mut rz = dot(&s.r, &s.z);
-    let r0 = dot(&s.r, &s.r).sqrt();
-    for _ in 0..settings.max_cg {
-        for i in 0..len {
-            s.q[i] = mass_term(n.mass[i]) * s.p[i];
-        }
-        add_stiffness(body, hess, &s.p, 1.0, &mut s.q);
-        if beta > 0.0 {
-            add_stiffness(body, &s.hess0, &s.p, beta / hd, &mut s.q);
-        }
-        for i in 0..len {
-            if !free[i] {
-                s.q[i] = DVec3::ZERO;
-            }
-            s.q[i] = filtered(s.q[i], s.filter[i]);
-        }
-        let pq = dot(&s.p, &s.q);
-        report.cg_iterations += 1;
-        if pq.is_nan() || pq <= 0.0 {
-            return false;
-        }
-        let a = rz / pq;
-        for i in 0..len {
-            s.dx[i] += a * s.p[i];
-            s.r[i] -= a * s.q[i];
-        }
-        if dot(&s.r, &s.r).sqrt() <= 1e-3 * r0 {
-            break;
-        }
-        apply(s);
-        let rz_new = dot(&s.r, &s.z);
-        let b = rz_new / rz;
-        rz = rz_new;
-        for i in 0..len {
-            s.p[i] = s.z[i] + b * s.p[i];
-        }
-    }
-    true
-}
-
-/// v without its part along the unit normal `n` (v itself for a zero n).
-fn filtered(v: DVec3, n: DVec3) -> DVec3 {
-    v - v.dot(n) * n
-}
-
-/// Moves every contact node that crossed its plane back onto it; whether any moved.
-fn clamp_to_contacts(contacts: &[super::NodeContact], x: &mut [Vec3A]) -> bool {
-    let mut moved = false;
-    for c in contacts {
-        let i = c.node as usize;
-        let gap = c.normal.dot(Vec3::from(x[i])) - c.offset;
-        if gap < 0.0 {
-            x[i] -= Vec3A::from(gap * c.normal);
-            moved = true;
-        }
-    }
-    moved
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::soft::{CellSplit, Material, StrainModel, TetMesh};
+    use glam::Vec3;
 
     /// The assembled node blocks (the factor's matrix) apply the same K as the matrix-free
     /// product the conjugate gradients use.
@@ -800,7 +277,9 @@ mod tests {
             })
             .collect();
         let mut free_product = vec![DVec3::ZERO; x.len()];
-        add_stiffness(&body, &hess, &dx, 1.0, &mut free_product);
+        for (k, h) in hess.iter().enumerate() {
+            body.apply(k, h, &dx, 1.0, &mut free_product);
+        }
         let mut assembled = vec![DVec3::ZERO; x.len()];
         for (k, t) in body.tets.iter().enumerate() {
             let b = gradients(body.dm_inv[k].as_dmat3());

@@ -39,8 +39,8 @@ mod plugin;
 pub mod strain;
 mod targets;
 
+pub use crate::integrator::ImplicitReport;
 pub use attach::{MAX_ATTACHED_NODES, NodeAttachments};
-pub use implicit::ImplicitReport;
 pub use mesh::{CellSplit, TetMesh};
 pub use plugin::SoftBodyPlugin;
 pub use strain::{StrainModel, Stress};
@@ -194,12 +194,7 @@ pub(crate) fn scatter_element_forces(f: &mut [Vec3A], t: [u32; 4], h: Mat3) {
 
 /// A node held outside a static or kinematic collider: the plane n·x ≥ d at the node's
 /// contact, moving with the collider over the next substep.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct NodeContact {
-    node: u32,
-    normal: Vec3,
-    offset: f32,
-}
+pub(crate) type NodeContact = crate::integrator::implicit::ContactPlane;
 
 impl SoftBody {
     /// The nodes and the body of `mesh` placed at `offset` (m), with masses lumped from the

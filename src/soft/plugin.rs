@@ -111,11 +111,11 @@ fn solve_implicit(
         ),
         Live,
     >,
-    mut scratch: Local<super::implicit::Scratch>,
+    mut scratch: Local<crate::integrator::implicit::Scratch<SoftBody>>,
 ) {
     for (e, mut nodes, mut body, settings, mut state) in &mut bodies {
         let body = body.bypass_change_detection();
-        match super::implicit::step(
+        match crate::integrator::implicit::step(
             body,
             nodes.bypass_change_detection(),
             settings,
