@@ -184,8 +184,8 @@ pub use rigid::{
     SkipRenormalization, Torque,
 };
 pub use schedule::{
-    ForceSchedule, ForceSystems, PhysicsSchedule, PhysicsSystems, RelaxSystems, StepSystems,
-    SubstepSchedule,
+    ForceSchedule, ForceSystems, ImplicitSystems, PhysicsSchedule, PhysicsSystems, RelaxSystems,
+    StepSystems, SubstepSchedule,
 };
 pub use sleep::{SleepPlugin, SleepSettings, Sleeping, SleepingDisabled};
 pub use springs::{

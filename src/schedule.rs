@@ -120,6 +120,16 @@ pub enum IntegrationSystems {
     Integrate,
 }
 
+/// The implicit solves inside [`IntegrationSystems::Integrate`], one per kind of mesh, in a
+/// fixed order (each solves its own meshes; the order only makes the schedule unambiguous).
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ImplicitSystems {
+    /// Soft bodies' tetrahedra.
+    SoftBodies,
+    /// Spring networks.
+    Springs,
+}
+
 /// The stages inside [`StepSystems::RelaxConstraints`]: the rigid contacts' relax pass, then
 /// the soft bodies' attachments (which move rigid bodies too) and node contacts, which have
 /// the last word on where a node may be.
@@ -249,6 +259,11 @@ pub(crate) fn init_schedules(world: &mut World) {
         (IntegrationSystems::Impulses, IntegrationSystems::Integrate)
             .chain()
             .in_set(StepSystems::IntegrateVelocities),
+    );
+    substep.configure_sets(
+        (ImplicitSystems::SoftBodies, ImplicitSystems::Springs)
+            .chain()
+            .in_set(IntegrationSystems::Integrate),
     );
     substep.configure_sets(
         (RelaxSystems::Rigid, RelaxSystems::Soft)

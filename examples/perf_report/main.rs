@@ -15,6 +15,7 @@ mod bevy_layer;
 mod contacts;
 mod rigid;
 mod soft;
+mod springs;
 #[path = "../common/timing.rs"]
 mod timing;
 
@@ -380,7 +381,7 @@ fn main() {
         "{:<48} {:>14} {:>14} {:>7}  note",
         "name", "ours_ns", "reference_ns", "ratio"
     );
-    // `--only particles|rigid|contacts|soft|bevy|dial` runs one group (bevy with `--features bevy`).
+    // `--only particles|rigid|contacts|springs|soft|bevy|dial` runs one group (bevy with `--features bevy`).
     let only = std::env::args()
         .skip_while(|a| a != "--only")
         .nth(1)
@@ -399,6 +400,9 @@ fn main() {
     }
     if run("contacts") {
         contacts::contact_scenes(&cfg, quick);
+    }
+    if run("springs") {
+        springs::implicit_springs(&cfg);
     }
     if run("soft") {
         soft::soft_lines(&cfg);

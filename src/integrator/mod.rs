@@ -158,6 +158,16 @@ pub struct ImplicitState {
     /// The substep the factor was made at, and whether the last solve asked for a new one.
     pub(crate) h: f32,
     pub(crate) refactor: bool,
+    /// The last substep's solve.
+    pub(crate) last: ImplicitReport,
+}
+
+impl ImplicitState {
+    /// What the last substep's solve did (Newton and CG iterations, final residual).
+    #[must_use]
+    pub fn last_solve(&self) -> ImplicitReport {
+        self.last
+    }
 }
 
 impl Default for ImplicitEuler {

@@ -9,8 +9,8 @@ use crate::integrator::{ImplicitEuler, ImplicitState};
 use crate::particles::Nodes;
 use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::schedule::{
-    FinishSystems, ForceSystems, IntegrationSystems, PhysicsSchedule, RelaxSystems,
-    SubstepSchedule, add_force_systems, add_systems,
+    FinishSystems, ForceSystems, PhysicsSchedule, RelaxSystems, SubstepSchedule, add_force_systems,
+    add_systems,
 };
 use crate::time::SubstepTime;
 
@@ -30,7 +30,7 @@ impl WorldPlugin for SoftBodyPlugin {
             SubstepSchedule,
             solve_implicit
                 .run_if(any_with_component::<ImplicitEuler>)
-                .in_set(IntegrationSystems::Integrate),
+                .in_set(crate::schedule::ImplicitSystems::SoftBodies),
         );
         add_systems(
             world,
@@ -125,6 +125,7 @@ fn solve_implicit(
         ) {
             Some(report) => {
                 body.stats.implicit = report;
+                state.bypass_change_detection().last = report;
                 // Backward Euler does not diverge, but a bad input can still fling nodes.
                 if let Some(reason) = crate::integrator::mesh_divergence(&nodes, &guard) {
                     commands.entity(e).insert(Quarantined { reason });

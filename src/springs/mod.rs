@@ -31,6 +31,7 @@
 //!   instead of looking entities up.
 
 mod builders;
+mod implicit;
 mod plugin;
 pub mod stability;
 

@@ -32,6 +32,13 @@ impl WorldPlugin for SpringPlugin {
                 .chain()
                 .in_set(ForceSystems::Springs)
         });
+        add_systems(
+            world,
+            crate::schedule::SubstepSchedule,
+            super::implicit::solve_implicit_springs
+                .run_if(any_with_component::<crate::integrator::ImplicitEuler>)
+                .in_set(crate::schedule::ImplicitSystems::Springs),
+        );
         world.init_resource::<super::EntitySpringStability>();
         world.init_resource::<bevy_ecs::message::Messages<super::StabilityWarning>>();
         add_systems(
@@ -149,9 +156,13 @@ fn apply_spring_forces(
     }
 }
 
+/// Explicit meshes only: an [`crate::ImplicitEuler`] mesh's springs act inside its solve.
 fn apply_network_forces(
     mut commands: Commands,
-    mut meshes: Query<(Entity, &mut Nodes, &SpringNetwork), Live>,
+    mut meshes: Query<
+        (Entity, &mut Nodes, &SpringNetwork),
+        (Live, Without<crate::integrator::ImplicitEuler>),
+    >,
 ) {
     for (e, mut nodes, network) in &mut meshes {
         if !network.accumulate(nodes.bypass_change_detection()) {
