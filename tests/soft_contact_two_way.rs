@@ -72,11 +72,7 @@ fn a_soft_cube_on_a_floating_platform_drags_it_down_at_m_g_over_the_total_mass()
         let n = w.get::<Nodes>(soft).unwrap();
         let cube_v = n.velocities().iter().map(|v| v.y).sum::<f32>() / n.len() as f32;
         let top = w.get::<Position>(platform).unwrap().0.y + 0.05;
-        let lowest = n
-            .positions()
-            .iter()
-            .map(|p| p.y)
-            .fold(f32::INFINITY, f32::min);
+        let lowest = n.bounds().map_or(f32::INFINITY, |b| b.0.y);
         println!(
             "implicit {implicit}: platform Δv over 0.75 s {measured:.4} m/s (closed form {expected:.4}); cube {cube_v:.3} m/s, platform {v1:.3} m/s; cube bottom {:.1} mm above the platform",
             1e3 * (lowest - top)
@@ -196,27 +192,14 @@ fn a_jelly_dropped_on_a_crate_on_the_ground_comes_to_rest_on_it() {
             w.step_physics();
             let n = w.get::<Nodes>(soft).unwrap();
 
-            peak = peak.max(
-                n.velocities()
-                    .iter()
-                    .map(|v| v.length())
-                    .fold(0.0, f32::max),
-            );
+            peak = peak.max(n.max_speed());
         }
         assert!(w.get::<Quarantined>(soft).is_none());
         let crate_y = w.get::<Position>(crate_).unwrap().0.y;
         let crate_v = w.get::<LinearVelocity>(crate_).unwrap().0.length();
         let n = w.get::<Nodes>(soft).unwrap();
-        let lowest = n
-            .positions()
-            .iter()
-            .map(|p| p.y)
-            .fold(f32::INFINITY, f32::min);
-        let speed = n
-            .velocities()
-            .iter()
-            .map(|v| v.length())
-            .fold(0.0, f32::max);
+        let lowest = n.bounds().map_or(f32::INFINITY, |b| b.0.y);
+        let speed = n.max_speed();
         let creep = n.positions().iter().map(|p| p.x).sum::<f32>() / n.len() as f32;
         println!(
             "implicit {implicit}: crate at {crate_y:.4} m (v {crate_v:.1e}), jelly bottom {:.1} mm above the crate, peak {peak:.2} m/s, now {speed:.1e} m/s, crept {:.1} mm sideways",

@@ -111,11 +111,7 @@ fn a_stiff_rope_at_60_hz_with_one_substep_hangs_with_each_spring_carrying_the_we
         let expected = segment + tension / k;
         worst = worst.max(((l - segment) / (expected - segment) - 1.0).abs());
     }
-    let speed = n
-        .velocities()
-        .iter()
-        .map(|v| v.length())
-        .fold(0.0, f32::max);
+    let speed = n.max_speed();
     let report = w.get::<ImplicitState>(e).unwrap().last_solve();
     println!(
         "stretch against the weight below, worst {:.2}% off; at rest {speed:.1e} m/s; explicit limit {:.2e} s vs h = {:.2e} s; last step {} Newton, {} CG",
@@ -150,25 +146,12 @@ fn a_stiff_cloth_pinned_at_two_corners_is_stable_implicit_where_explicit_needs_m
         let r = w.get::<ImplicitState>(e).unwrap().last_solve();
         (newton, cg) = (newton + r.newton_iterations, cg + r.cg_iterations);
         let n = w.get::<Nodes>(e).unwrap();
-        peak = peak.max(
-            n.velocities()
-                .iter()
-                .map(|v| v.length())
-                .fold(0.0, f32::max),
-        );
+        peak = peak.max(n.max_speed());
     }
     assert!(w.get::<Quarantined>(e).is_none());
     let n = w.get::<Nodes>(e).unwrap();
-    let lowest = n
-        .positions()
-        .iter()
-        .map(|p| p.y)
-        .fold(f32::INFINITY, f32::min);
-    let speed = n
-        .velocities()
-        .iter()
-        .map(|v| v.length())
-        .fold(0.0, f32::max);
+    let lowest = n.bounds().map_or(f32::INFINITY, |b| b.0.y);
+    let speed = n.max_speed();
     println!(
         "32×32 cloth, explicit limit {limit:.2e} s ({needed} substeps at 60 Hz); implicit ×1: 10 s bounded, peak {peak:.2} m/s, lowest node at {lowest:.3} m, now {speed:.2} m/s; {:.1} Newton, {:.1} CG per step",
         f64::from(newton) / 600.0,

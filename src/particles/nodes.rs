@@ -189,6 +189,21 @@ impl Nodes {
         })
     }
 
+    /// The nodes' bounding box (min, max corners, m); None for no nodes.
+    #[must_use]
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let first = Vec3::from(*self.x.first()?);
+        Some(self.x.iter().fold((first, first), |(lo, hi), p| {
+            (lo.min(Vec3::from(*p)), hi.max(Vec3::from(*p)))
+        }))
+    }
+
+    /// The fastest node's speed (m/s); 0 for no nodes.
+    #[must_use]
+    pub fn max_speed(&self) -> f32 {
+        self.v.iter().map(|v| v.length()).fold(0.0, f32::max)
+    }
+
     /// True when every position and velocity is finite.
     #[must_use]
     pub fn is_finite(&self) -> bool {

@@ -114,7 +114,7 @@ pub(crate) fn collide_nodes(
             .filter(|f| f.is_factored());
         body.contacts.clear();
         let thickness = body.contact_thickness;
-        let Some((lo, hi)) = bounds(&n.x) else {
+        let Some((lo, hi)) = n.bounds() else {
             continue;
         };
         let (lo, hi) = (lo - Vec3::splat(thickness), hi + Vec3::splat(thickness));
@@ -166,13 +166,6 @@ pub(crate) fn collide_nodes(
     for (entity, add) in fresh {
         commands.entity(entity).insert(add);
     }
-}
-
-fn bounds(x: &[Vec3A]) -> Option<(Vec3, Vec3)> {
-    let first = Vec3::from(*x.first()?);
-    Some(x.iter().fold((first, first), |(lo, hi), p| {
-        (lo.min(Vec3::from(*p)), hi.max(Vec3::from(*p)))
-    }))
 }
 
 /// A node in a collider's contact layer: its outward normal (world) and its overlap with
