@@ -19,6 +19,9 @@ pub struct ChainBuilder {
     damping: f32,
     bend_stiffness: f32,
     pin_start: bool,
+    pin_end: bool,
+    rest_scale: f32,
+    end_load: f32,
 }
 
 /// The entities of a spawned chain, from the start node to the end node.
@@ -54,6 +57,9 @@ impl ChainBuilder {
             damping: 0.5,
             bend_stiffness: 0.0,
             pin_start: true,
+            pin_end: false,
+            rest_scale: 1.0,
+            end_load: 0.0,
         }
     }
 
@@ -106,6 +112,29 @@ impl ChainBuilder {
         self
     }
 
+    /// Whether the end node is pinned too (a rope strung between two points).
+    #[must_use]
+    pub fn pin_end(mut self, pin: bool) -> Self {
+        self.pin_end = pin;
+        self
+    }
+
+    /// Each segment's rest length over its built length (dimensionless, default 1): above 1
+    /// the rope is built with slack (a rope of rest length `scale` × the span), below 1 it is
+    /// pre-tensioned (tension k (1 − scale) × segment length when both ends are pinned).
+    #[must_use]
+    pub fn rest_scale(mut self, scale: f32) -> Self {
+        self.rest_scale = scale;
+        self
+    }
+
+    /// A load (kg) hung on the end node, added to its mass (0 for none).
+    #[must_use]
+    pub fn end_load(mut self, kg: f32) -> Self {
+        self.end_load = kg;
+        self
+    }
+
     /// Spawns the particles and springs.
     ///
     /// # Errors
@@ -137,18 +166,23 @@ impl ChainBuilder {
         let k = non_negative("spring stiffness", self.stiffness)?;
         let c = non_negative("spring damping", self.damping)?;
         let kb = non_negative("bending stiffness", self.bend_stiffness)?;
+        let scale = positive("rest length scale", self.rest_scale)?;
+        let load = non_negative("end load", self.end_load)?;
         let step = (end - start) / (self.nodes - 1) as f32;
         let mut bundles = Vec::with_capacity(self.nodes);
         for i in 0..self.nodes {
             let x = start + step * i as f32;
-            bundles.push(if i == 0 && self.pin_start {
+            let last = i + 1 == self.nodes;
+            bundles.push(if (i == 0 && self.pin_start) || (last && self.pin_end) {
                 ParticleBundle::pinned(x)?
+            } else if last {
+                ParticleBundle::new(x, Vec3::ZERO, self.node_mass + load)?
             } else {
                 ParticleBundle::new(x, Vec3::ZERO, self.node_mass)?
             });
         }
         let nodes: Vec<Entity> = bundles.into_iter().map(|b| world.spawn_one(b)).collect();
-        let seg = step.length();
+        let seg = step.length() * scale;
         let mut chain = Chain {
             nodes,
             ..Default::default()

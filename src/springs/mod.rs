@@ -152,6 +152,25 @@ impl Spring {
         (self.anchor_a, self.anchor_b)
     }
 
+    /// The spring's current length, strain and tension, from its ends' positions in
+    /// `world` (anchors included); None if an end has no `Position`.
+    #[must_use]
+    pub fn reading(&self, world: &World) -> Option<SpringReading> {
+        let end = |e: Entity, anchor: Vec3| -> Option<Vec3A> {
+            let x = world.get::<Position>(e)?.0;
+            let r = world
+                .get::<crate::rigid::Rotation>(e)
+                .map_or(Vec3A::from(anchor), |q| q.0 * Vec3A::from(anchor));
+            Some(x + r)
+        };
+        let (a, b) = (end(self.a, self.anchor_a)?, end(self.b, self.anchor_b)?);
+        Some(SpringReading::new(
+            (b - a).length(),
+            self.rest_length,
+            self.stiffness,
+        ))
+    }
+
     /// Spawns this spring after checking that both endpoints are bodies.
     ///
     /// # Errors
@@ -217,6 +236,35 @@ fn validate_spring(mut world: DeferredWorld, ctx: HookContext) {
         world.commands().entity(ctx.entity).insert(Quarantined {
             reason: QuarantineReason::InvalidInput(err),
         });
+    }
+}
+
+/// A spring's state: its length (m), strain (l − r)/r (dimensionless; infinite for a
+/// stretched zero-length spring) and tension k (l − r) (N; negative when compressed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpringReading {
+    /// Current length (m).
+    pub length: f32,
+    /// (l − r) / r.
+    pub strain: f32,
+    /// k (l − r) (N).
+    pub tension: f32,
+}
+
+impl SpringReading {
+    fn new(length: f32, rest: f32, k: f32) -> Self {
+        let s = length - rest;
+        Self {
+            length,
+            strain: if rest > 0.0 {
+                s / rest
+            } else if s == 0.0 {
+                0.0
+            } else {
+                f32::INFINITY
+            },
+            tension: k * s,
+        }
     }
 }
 
@@ -291,6 +339,20 @@ impl SpringNetwork {
     #[must_use]
     pub fn ends(&self) -> &[[u32; 2]] {
         &self.ends
+    }
+
+    /// Spring `i`'s length, strain and tension over `nodes`; None when `i` or its ends are
+    /// out of range.
+    #[must_use]
+    pub fn reading(&self, i: usize, nodes: &Nodes) -> Option<SpringReading> {
+        let [a, b] = *self.ends.get(i)?;
+        let x = nodes.positions();
+        let (pa, pb) = (x.get(a as usize)?, x.get(b as usize)?);
+        Some(SpringReading::new(
+            (*pb - *pa).length(),
+            self.rest[i],
+            self.k[i],
+        ))
     }
 
     /// True when every endpoint indexes into `nodes`.

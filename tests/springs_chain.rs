@@ -1,0 +1,112 @@
+//! Ropes a game can build (`ChainBuilder`): a load hung at the end, both ends pinned,
+//! pre-tension; springs read out their length, strain and tension (`Spring::reading`,
+//! `SpringNetwork::reading`), against closed forms.
+
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use hooke::prelude::*;
+use hooke::{ChainBuilder, LinearDamping, Spring};
+
+fn world() -> World {
+    let mut w = World::new();
+    w.add_physics(PhysicsPlugins);
+    w
+}
+
+#[test]
+fn a_hanging_chain_with_a_load_has_each_spring_carry_the_weight_below_it() {
+    let mut w = world();
+    let (count, load) = (11usize, 1.0f32);
+    let chain = ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.0, 1.0, 0.0), count)
+        .stiffness(2000.0)
+        .end_load(load)
+        .spawn(&mut w)
+        .unwrap();
+    for &n in &chain.nodes[1..] {
+        w.entity_mut(n).insert(LinearDamping(3.0));
+    }
+    assert_eq!(
+        w.get::<Mass>(chain.nodes[count - 1]).unwrap().value(),
+        0.1 + load
+    );
+    for _ in 0..600 {
+        w.step_physics();
+    }
+    let mut worst = 0.0f32;
+    for (i, &s) in chain.springs.iter().enumerate() {
+        let reading = w.get::<Spring>(s).unwrap().reading(&w).unwrap();
+        // Spring i holds nodes i+1 .. count−1: (count − 2 − i) plain nodes and the loaded end.
+        let below = ((count - 2 - i) as f32 * 0.1 + 0.1 + load) * 9.81;
+        worst = worst.max((reading.tension / below - 1.0).abs());
+        assert!((reading.strain - reading.tension / (2000.0 * 0.1)).abs() < 1e-3);
+    }
+    let top = w
+        .get::<Spring>(chain.springs[0])
+        .unwrap()
+        .reading(&w)
+        .unwrap();
+    println!(
+        "top spring {:.2} N (closed form {:.2} N), stretched to {:.4} m; worst tension error {:.3}%",
+        top.tension,
+        (0.1 * 9.0 + 0.1 + load) * 9.81,
+        top.length,
+        100.0 * worst
+    );
+    assert!(worst < 0.01, "{worst}");
+}
+
+#[test]
+fn a_rope_pinned_at_both_ends_and_pre_tensioned_holds_its_tension() {
+    let mut w = world();
+    w.insert_resource(hooke::Gravity::new(Vec3::ZERO).unwrap());
+    let (k, scale) = (500.0f32, 0.9f32);
+    let chain = ChainBuilder::rope(Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), 9)
+        .stiffness(k)
+        .pin_end(true)
+        .rest_scale(scale)
+        .spawn(&mut w)
+        .unwrap();
+    assert!(w.get::<Mass>(chain.nodes[8]).unwrap().is_pinned());
+    for _ in 0..120 {
+        w.step_physics();
+    }
+    // Each segment is 0.25 m long with rest 0.225 m: tension k · 0.025 = 12.5 N.
+    for &s in &chain.springs {
+        let r = w.get::<Spring>(s).unwrap().reading(&w).unwrap();
+        assert!((r.tension - k * 0.25 * (1.0 - scale)).abs() < 1e-2, "{r:?}");
+        assert!((r.strain - (1.0 / scale - 1.0)).abs() < 1e-4, "{r:?}");
+    }
+    assert!(matches!(
+        ChainBuilder::rope(Vec3::ZERO, Vec3::X, 3)
+            .rest_scale(0.0)
+            .spawn(&mut w),
+        Err(hooke::Error::NotPositive { .. })
+    ));
+    assert!(matches!(
+        ChainBuilder::rope(Vec3::ZERO, Vec3::X, 3)
+            .end_load(-1.0)
+            .spawn(&mut w),
+        Err(hooke::Error::Negative { .. })
+    ));
+}
+
+#[test]
+fn a_spring_network_reads_out_each_spring() {
+    let mut nodes = Nodes::new();
+    nodes.push(Vec3::ZERO, Vec3::ZERO, 1.0).unwrap();
+    nodes
+        .push(Vec3::new(1.5, 0.0, 0.0), Vec3::ZERO, 1.0)
+        .unwrap();
+    nodes
+        .push(Vec3::new(1.5, 0.0, 0.0), Vec3::ZERO, 1.0)
+        .unwrap();
+    let mut net = SpringNetwork::new();
+    net.push(0, 1, 1.0, 10.0, 0.0).unwrap();
+    net.push(1, 2, 0.0, 10.0, 0.0).unwrap();
+    let r = net.reading(0, &nodes).unwrap();
+    assert_eq!((r.length, r.strain, r.tension), (1.5, 0.5, 5.0));
+    // A zero-length spring whose ends coincide: no strain, no tension, no NaN.
+    let r = net.reading(1, &nodes).unwrap();
+    assert_eq!((r.length, r.strain, r.tension), (0.0, 0.0, 0.0));
+    assert!(net.reading(2, &nodes).is_none());
+}
