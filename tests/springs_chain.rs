@@ -110,3 +110,89 @@ fn a_spring_network_reads_out_each_spring() {
     assert_eq!((r.length, r.strain, r.tension), (0.0, 0.0, 0.0));
     assert!(net.reading(2, &nodes).is_none());
 }
+
+/// A rope of rest length L = 2.5 m strung between pins 2 m apart hangs on the catenary
+/// y = a cosh(x/a), with L = 2a sinh(S/2a): sag a (cosh(S/2a) − 1) and support tension
+/// w a cosh(S/2a) (w the weight per length). Springs stiff enough to stretch < 0.5 %, at the
+/// substeps the stability warning asks for.
+#[test]
+fn a_rope_between_two_pins_hangs_on_the_catenary() {
+    let (span, length, count, node_kg, k) = (2.0f32, 2.5f32, 41usize, 0.05f32, 1e5f32);
+    let build = || {
+        ChainBuilder::rope(Vec3::new(-1.0, 3.0, 0.0), Vec3::new(1.0, 3.0, 0.0), count)
+            .node_mass(node_kg)
+            .stiffness(k)
+            .damping(0.0)
+            .pin_end(true)
+            .rest_scale(length / span)
+    };
+    // Ask for the substeps.
+    let mut probe = world();
+    build().spawn(&mut probe).unwrap();
+    probe.step_physics();
+    let needed = {
+        let m = probe.resource::<bevy_ecs::message::Messages<hooke::StabilityWarning>>();
+        m.get_cursor().read(m).next().unwrap().substeps_needed
+    };
+    let mut w = hooke::scenes::world_with(
+        1.0 / 60.0,
+        needed,
+        Integrator::SymplecticEuler,
+        Vec3::new(0.0, -9.81, 0.0),
+    )
+    .unwrap();
+    let chain = build().spawn(&mut w).unwrap();
+    for &n in &chain.nodes {
+        w.entity_mut(n).insert(LinearDamping(2.0));
+    }
+    for _ in 0..900 {
+        w.step_physics();
+    }
+    let lowest = chain
+        .nodes
+        .iter()
+        .map(|&n| w.get::<Position>(n).unwrap().0.y)
+        .fold(f32::INFINITY, f32::min);
+    let sag = 3.0 - lowest;
+    // a from L = 2a sinh(S/2a), by bisection (the right side falls as a grows).
+    let (mut lo, mut hi) = (0.05f64, 100.0f64);
+    for _ in 0..200 {
+        let a = 0.5 * (lo + hi);
+        if 2.0 * a * (f64::from(span) / (2.0 * a)).sinh() > f64::from(length) {
+            lo = a;
+        } else {
+            hi = a;
+        }
+    }
+    let a = 0.5 * (lo + hi);
+    let c = (f64::from(span) / (2.0 * a)).cosh();
+    let closed_sag = (a * (c - 1.0)) as f32;
+    // The pinned ends carry half a node's weight each less than the rope's: w per rest length.
+    let w_per_m = f64::from(node_kg) * 9.81 * (count - 2) as f64 / f64::from(length);
+    let closed_tension = (w_per_m * a * c) as f32;
+    let support = w
+        .get::<Spring>(chain.springs[0])
+        .unwrap()
+        .reading(&w)
+        .unwrap();
+    let strain = chain
+        .springs
+        .iter()
+        .map(|&s| w.get::<Spring>(s).unwrap().reading(&w).unwrap().strain)
+        .fold(0.0f32, f32::max);
+    println!(
+        "{needed} substeps; sag {sag:.4} m (catenary {closed_sag:.4}), support tension {:.2} N (catenary {closed_tension:.2}), largest strain {:.2}%",
+        support.tension,
+        100.0 * strain
+    );
+    assert!(strain < 5e-3);
+    assert!(
+        (sag / closed_sag - 1.0).abs() < 0.02,
+        "{sag} vs {closed_sag}"
+    );
+    assert!(
+        (support.tension / closed_tension - 1.0).abs() < 0.03,
+        "{} vs {closed_tension}",
+        support.tension
+    );
+}
