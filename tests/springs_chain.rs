@@ -196,3 +196,66 @@ fn a_rope_between_two_pins_hangs_on_the_catenary() {
         support.tension
     );
 }
+
+/// A taut string (tension T, mass per length μ) carries transverse waves at c = √(T/μ): a
+/// Gaussian pulse launched rightwards travels at c within 2 %.
+#[test]
+fn a_taut_strings_transverse_waves_travel_at_the_square_root_of_tension_over_density() {
+    let (count, seg, node_kg, k) = (401usize, 0.01f32, 0.001f32, 2000.0f32);
+    let rest = 0.9 * seg;
+    let tension = k * (seg - rest); // 2 N
+    let mu = node_kg / seg; // 0.1 kg/m
+    let c = (tension / mu).sqrt(); // 4.47 m/s
+    let pulse = |x: f32| 0.01 * (-((x - 1.0) / 0.1).powi(2)).exp();
+    let slope = |x: f32| pulse(x) * (-2.0 * (x - 1.0) / 0.01);
+    let mut nodes = Nodes::new();
+    for i in 0..count {
+        let x = seg * i as f32;
+        if i == 0 || i + 1 == count {
+            nodes.push_pinned(Vec3::new(x, 0.0, 0.0)).unwrap();
+        } else {
+            // Moving right: y(x − c t), so ẏ = −c y'.
+            nodes
+                .push(
+                    Vec3::new(x, pulse(x), 0.0),
+                    Vec3::new(0.0, -c * slope(x), 0.0),
+                    node_kg,
+                )
+                .unwrap();
+        }
+    }
+    let mut net = SpringNetwork::new();
+    for i in 0..count - 1 {
+        net.push(i, i + 1, rest, k, 0.0).unwrap();
+    }
+    let limit = net.critical_step(&nodes);
+    let substeps = ((1.0 / 60.0) / (0.5 * limit)).ceil() as u32;
+    let mut w = hooke::scenes::world_with(
+        1.0 / 60.0,
+        substeps,
+        Integrator::SymplecticEuler,
+        Vec3::ZERO,
+    )
+    .unwrap();
+    let e = w.spawn((nodes, net)).id();
+    let peak_x = |w: &World| {
+        let n = w.get::<Nodes>(e).unwrap();
+        let (i, _) = n
+            .positions()
+            .iter()
+            .enumerate()
+            .fold(
+                (0, f32::MIN),
+                |(bi, by), (i, p)| if p.y > by { (i, p.y) } else { (bi, by) },
+            );
+        n.positions()[i].x
+    };
+    let x0 = peak_x(&w);
+    let steps = 30; // 0.5 s: the pulse moves about 2.2 m, short of the far end at 4 m
+    for _ in 0..steps {
+        w.step_physics();
+    }
+    let speed = (peak_x(&w) - x0) / (steps as f32 / 60.0);
+    println!("pulse speed {speed:.3} m/s, √(T/μ) = {c:.3} m/s ({substeps} substeps)");
+    assert!((speed / c - 1.0).abs() < 0.02, "{speed} vs {c}");
+}
