@@ -505,13 +505,23 @@ pub(crate) fn step<E: ImplicitElements>(
         }
 
         // A correction below the resolution of f32 positions (a few ulps of the body's
-        // extent) is the last one that can change anything: take it and stop.
+        // extent) is the last one that can change anything: take it whole and stop. A line
+        // search there compares energies at their rounding floor and would only backtrack
+        // twelve times, each a full element pass.
         let scale = n.x.iter().fold(0.0f32, |m, x| m.max(x.abs().max_element()));
         let resolution = 16.0 * f64::from(f32::EPSILON) * f64::from(scale.max(1e-3));
         let last =
             s.dx.iter()
                 .zip(&free)
                 .all(|(d, &f)| !f || d.abs().max_element() <= resolution);
+        if last {
+            for i in 0..len {
+                n.x[i] = Vec3A::from((d3(n.x[i]) + s.dx[i]).as_vec3());
+            }
+            clamp_to_contacts(body.planes(), &mut n.x);
+            elastic_now = body.prepare(&n.x, &mut s.prep);
+            break;
+        }
 
         // Backtracking line search on E.
         let e_now = elastic_now + potential_rest(body, n, s, &n.x, hd, alpha);
@@ -542,9 +552,6 @@ pub(crate) fn step<E: ImplicitElements>(
         n.x.copy_from_slice(&s.trial);
         if moved {
             elastic_now = body.prepare(&n.x, &mut s.prep);
-        }
-        if last {
-            break;
         }
     }
     for i in 0..len {
