@@ -110,14 +110,7 @@ pub fn soft_lines(cfg: &Config) {
     // Whole steps of a falling 10k-tet body at 60 Hz: implicit with one substep against
     // symplectic Euler at the substeps its stability needs (E = 1e6 here).
     let step_world = |implicit: bool, substeps: u32| {
-        let mut w = scenes::world_with(
-            1.0 / 60.0,
-            substeps,
-            Integrator::SymplecticEuler,
-            Vec3::new(0.0, -9.81, 0.0),
-        )
-        .unwrap();
-        w.resource_mut::<DiagnosticsSettings>().energy = false;
+        let mut w = crate::quiet_world(1.0 / 60.0, substeps, Integrator::SymplecticEuler);
         let (_, nodes, sb) = body(StrainModel::Corotated);
         let e = if implicit {
             w.spawn((nodes, sb, ImplicitEuler::default())).id()
@@ -183,14 +176,7 @@ pub fn cantilever_vs_rapier(cfg: &Config, steps: usize) {
     for nodes in [[9usize, 3, 3], [17, 5, 5]] {
         let cells = [nodes[0] - 1, nodes[1] - 1, nodes[2] - 1];
         // hooke
-        let mut w = scenes::world_with(
-            1.0 / 60.0,
-            1,
-            Integrator::SymplecticEuler,
-            Vec3::new(0.0, -9.81, 0.0),
-        )
-        .unwrap();
-        w.resource_mut::<DiagnosticsSettings>().energy = false;
+        let mut w = crate::quiet_world(1.0 / 60.0, 1, Integrator::SymplecticEuler);
         let mesh = TetMesh::cuboid(Vec3::new(length, side, side), cells, CellSplit::Five).unwrap();
         let volume = length * side * side;
         let material = Material::new(young, 0.0, 8.0 / volume).unwrap();

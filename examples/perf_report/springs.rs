@@ -4,19 +4,12 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::prelude::*;
-use hooke::{ClothBuilder, ImplicitEuler, ImplicitState, scenes};
+use hooke::{ClothBuilder, ImplicitEuler, ImplicitState};
 
 use crate::timing::{Config, compare, line};
 
 fn world(substeps: u32) -> World {
-    let mut w = scenes::world_with(
-        1.0 / 60.0,
-        substeps,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -9.81, 0.0),
-    )
-    .unwrap();
-    w.resource_mut::<DiagnosticsSettings>().energy = false;
+    let mut w = crate::quiet_world(1.0 / 60.0, substeps, Integrator::SymplecticEuler);
     w.resource_mut::<hooke::SleepSettings>().enabled = false;
     w
 }

@@ -144,7 +144,7 @@ impl NodeAttachments {
 type Soft<'a> = (
     &'a mut Nodes,
     &'a mut NodeAttachments,
-    Option<&'a mut ImplicitState>,
+    Option<&'a ImplicitState>,
     Option<&'a ImplicitEuler>,
 );
 
@@ -169,10 +169,9 @@ pub(crate) fn solve_attachments(
     if h.is_nan() || h <= 0.0 {
         return;
     }
-    for (mut nodes, mut attachments, mut state, implicit) in &mut meshes {
+    for (mut nodes, mut attachments, state, implicit) in &mut meshes {
         let nodes = nodes.bypass_change_detection();
         let factor = state
-            .as_deref_mut()
             .filter(|_| implicit.is_some())
             .and_then(|s| s.factor.as_ref())
             .filter(|f| f.is_factored());
