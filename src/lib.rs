@@ -190,7 +190,7 @@ pub use schedule::{
 pub use sleep::{SleepPlugin, SleepSettings, Sleeping, SleepingDisabled};
 pub use springs::{
     Chain, ChainBuilder, ClothBuilder, EntitySpringStability, Spring, SpringNetwork, SpringPlugin,
-    SpringReading, SpringStability, StabilityWarning,
+    SpringReading, SpringStability, StabilityPolicy, StabilityWarning,
 };
 pub use time::{FrameReport, PhysicsTime, SubstepTime};
 

@@ -106,8 +106,10 @@ pub enum ForceSystems {
     Springs,
     /// Elastic forces of deformable meshes.
     Elasticity,
-    /// Forces added by game code, last.
+    /// Forces added by game code.
     User,
+    /// Spring entities solved by backward Euler, last: every other force is their f_ext.
+    ImplicitSprings,
 }
 
 /// The two stages inside [`StepSystems::IntegrateVelocities`]: impulses first (they change
@@ -279,6 +281,7 @@ pub(crate) fn init_schedules(world: &mut World) {
                 ForceSystems::Springs,
                 ForceSystems::Elasticity,
                 ForceSystems::User,
+                ForceSystems::ImplicitSprings,
             )
                 .chain()
                 .in_set(StepSystems::ApplyForces),

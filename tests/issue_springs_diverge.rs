@@ -2,7 +2,9 @@
 //! enough to stretch < 0.1 % under its weight used to reach 1e23 m in two steps, finite and
 //! never quarantined, and nothing told the user why. Now the stability limit is known and told
 //! (`StabilityWarning`), and what diverges is caught in the step it happens
-//! (`DivergenceGuard`).
+//! (`DivergenceGuard`). These tests keep the springs explicit (`StabilityPolicy::Warn`) to
+//! watch the guard; at the default policy the same rope is solved implicitly
+//! (tests/springs_implicit_entities.rs).
 
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
@@ -13,9 +15,11 @@ use hooke::{
     StabilityWarning, scenes,
 };
 
+/// The defaults, but springs past their limit stay explicit.
 fn default_world() -> World {
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
+    w.insert_resource(hooke::StabilityPolicy::Warn);
     w
 }
 
@@ -142,6 +146,7 @@ fn the_critical_step_of_a_two_mass_spring_is_the_closed_form_and_is_the_edge() {
     for (factor, stable) in [(0.95f32, true), (1.05, false)] {
         let mut w = scenes::world_with(factor * closed, 1, Integrator::SymplecticEuler, Vec3::ZERO)
             .unwrap();
+        w.insert_resource(hooke::StabilityPolicy::Warn);
         let e = w.spawn((nodes.clone(), net.clone())).id();
         let mut peak = 0.0f32;
         for _ in 0..2000 {

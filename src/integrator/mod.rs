@@ -9,6 +9,7 @@
 //! | [`Integrator::SymplecticEuler`] (default) | v ← v + h a(x₀, v₀), x ← x + h v (new v) | 1 | 1 |
 //! | [`Integrator::VelocityVerlet`] | v½ = v + ½h a₀, x ← x + h v½, v ← v½ + ½h a(x₁, v½) | 2 | 2 |
 //! | [`Integrator::Rk4`] | classic Runge–Kutta on (ẋ, v̇) = (v, a) | 4 | 4 |
+//! | [`Integrator::ImplicitEuler`] | v ← v + h a(x₁, v₁), x ← x + h v (backward Euler) | 1 | Newton |
 //!
 //! Symplectic Euler is the lecture's scheme and the default: it costs one force evaluation,
 //! and on an undamped oscillator its energy stays bounded (error about ωh/2) instead of
@@ -63,11 +64,26 @@ pub enum Integrator {
     VelocityVerlet,
     /// Classic fourth-order Runge–Kutta. Four force evaluations; slowly loses energy.
     Rk4,
+    /// Backward Euler: unconditionally stable, first order, damps. Springs ([`crate::Spring`]
+    /// entities and `SpringNetwork` meshes) and soft bodies are solved by Newton's method
+    /// ([`ImplicitEuler`] holds the solver's settings); every other force is integrated as
+    /// by symplectic Euler, which for forces that do not depend on the state is the same
+    /// step.
+    ImplicitEuler,
 }
 
 impl Integrator {
     /// Every integrator, cheapest first.
-    pub const ALL: [Integrator; 4] = [
+    pub const ALL: [Integrator; 5] = [
+        Integrator::ExplicitEuler,
+        Integrator::SymplecticEuler,
+        Integrator::VelocityVerlet,
+        Integrator::Rk4,
+        Integrator::ImplicitEuler,
+    ];
+
+    /// The explicit integrators (every one but [`Integrator::ImplicitEuler`]).
+    pub const EXPLICIT: [Integrator; 4] = [
         Integrator::ExplicitEuler,
         Integrator::SymplecticEuler,
         Integrator::VelocityVerlet,
@@ -78,17 +94,22 @@ impl Integrator {
     #[must_use]
     pub const fn order(self) -> u32 {
         match self {
-            Integrator::ExplicitEuler | Integrator::SymplecticEuler => 1,
+            Integrator::ExplicitEuler | Integrator::SymplecticEuler | Integrator::ImplicitEuler => {
+                1
+            }
             Integrator::VelocityVerlet => 2,
             Integrator::Rk4 => 4,
         }
     }
 
-    /// Force evaluations per step.
+    /// Force evaluations per step (for [`Integrator::ImplicitEuler`], the springs' and soft
+    /// bodies' Newton iterations come on top).
     #[must_use]
     pub const fn force_evaluations(self) -> u32 {
         match self {
-            Integrator::ExplicitEuler | Integrator::SymplecticEuler => 1,
+            Integrator::ExplicitEuler | Integrator::SymplecticEuler | Integrator::ImplicitEuler => {
+                1
+            }
             Integrator::VelocityVerlet => 2,
             Integrator::Rk4 => 4,
         }
@@ -102,6 +123,7 @@ impl Integrator {
             Integrator::SymplecticEuler => "symplectic_euler",
             Integrator::VelocityVerlet => "velocity_verlet",
             Integrator::Rk4 => "rk4",
+            Integrator::ImplicitEuler => "implicit_euler",
         }
     }
 
@@ -109,6 +131,17 @@ impl Integrator {
     #[must_use]
     pub const fn is_multistage(self) -> bool {
         matches!(self, Integrator::VelocityVerlet | Integrator::Rk4)
+    }
+
+    /// True for the integrators whose velocity update is v ← v + h f / m followed by
+    /// x ← x + h v (symplectic and backward Euler): a spring solved implicitly hands its
+    /// endpoints the force f that makes that update land on the backward-Euler state.
+    #[must_use]
+    pub const fn kicks_then_drifts(self) -> bool {
+        matches!(
+            self,
+            Integrator::SymplecticEuler | Integrator::ImplicitEuler
+        )
     }
 }
 
@@ -178,6 +211,37 @@ impl Default for ImplicitEuler {
             max_cg: 200,
             max_factor_entries: 2_000_000,
             refactor_after: 4,
+        }
+    }
+}
+
+/// Marks an [`ImplicitEuler`] that [`Integrator::ImplicitEuler`] (the global dial) put on a
+/// mesh, so that leaving the dial takes it off again.
+#[derive(Component, Debug, Clone, Copy, Default)]
+pub(crate) struct ImplicitByDial;
+
+/// While the global [`Integrator`] is [`Integrator::ImplicitEuler`], gives every mesh with an
+/// `M` (an effect's element component: a spring network, a soft body) and neither an
+/// [`ImplicitEuler`] nor an [`IntegratorOverride`] the default solver; takes the ones it gave
+/// back off when the dial moves away. Each effect registers it for its own `M`.
+#[allow(clippy::type_complexity)] // the filters are the point
+pub(crate) fn follow_implicit_dial<M: Component>(
+    mut commands: Commands,
+    global: Res<Integrator>,
+    adopt: Query<Entity, (With<M>, Without<ImplicitEuler>, Without<IntegratorOverride>)>,
+    given: Query<Entity, (With<M>, With<ImplicitByDial>)>,
+) {
+    if *global == Integrator::ImplicitEuler {
+        for e in &adopt {
+            commands
+                .entity(e)
+                .insert((ImplicitEuler::default(), ImplicitByDial));
+        }
+    } else {
+        for e in &given {
+            commands
+                .entity(e)
+                .remove::<(ImplicitEuler, ImplicitState, ImplicitByDial)>();
         }
     }
 }

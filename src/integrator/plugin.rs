@@ -26,7 +26,7 @@ pub struct ConstraintsActive(pub bool);
 
 impl ConstraintsActive {
     fn fuses(self, method: Integrator) -> bool {
-        !self.0 && method == Integrator::SymplecticEuler
+        !self.0 && method.kicks_then_drifts()
     }
 }
 
@@ -163,7 +163,7 @@ pub(crate) fn apply_impulses(
 fn velocity_phase(method: Integrator, x: &mut Vec3A, v: &mut Vec3A, a: Vec3A, h: f32) {
     match method {
         Integrator::ExplicitEuler => (*x, *v) = explicit_euler(*x, *v, a, h),
-        Integrator::SymplecticEuler => *v = kick(*v, a, h),
+        Integrator::SymplecticEuler | Integrator::ImplicitEuler => *v = kick(*v, a, h),
         Integrator::VelocityVerlet => *v = kick(*v, a, 0.5 * h),
         Integrator::Rk4 => {}
     }
@@ -174,7 +174,7 @@ fn velocity_phase(method: Integrator, x: &mut Vec3A, v: &mut Vec3A, a: Vec3A, h:
 fn position_phase(method: Integrator, x: &mut Vec3A, v: Vec3A, h: f32) {
     if matches!(
         method,
-        Integrator::SymplecticEuler | Integrator::VelocityVerlet
+        Integrator::SymplecticEuler | Integrator::VelocityVerlet | Integrator::ImplicitEuler
     ) {
         *x = drift(*x, v, h);
     }
@@ -229,7 +229,7 @@ fn integrate_velocities(
         if probe != Vec3A::ZERO {
             quarantine_suspects(&mut commands, &set.p2(), &guard);
         }
-    } else if method == Integrator::SymplecticEuler {
+    } else if method.kicks_then_drifts() {
         set.p0().iter_mut().for_each(|(_, mut v, f, m)| {
             v.0 = kick(v.0, f.0 * m.inverse(), h);
         });
@@ -337,7 +337,7 @@ fn integrate_positions(
         // Done in the velocity pass.
     } else if matches!(
         method,
-        Integrator::SymplecticEuler | Integrator::VelocityVerlet
+        Integrator::SymplecticEuler | Integrator::VelocityVerlet | Integrator::ImplicitEuler
     ) {
         bodies.p0().iter_mut().for_each(|(mut x, v)| {
             let (xa, va) = (x.0, v.0);
@@ -355,7 +355,7 @@ fn integrate_positions(
     bodies.p1().iter_mut().for_each(|((mut x, v), o)| {
         if matches!(
             o.0,
-            Integrator::SymplecticEuler | Integrator::VelocityVerlet
+            Integrator::SymplecticEuler | Integrator::VelocityVerlet | Integrator::ImplicitEuler
         ) {
             x.0 = drift(x.0, v.0, h);
         }

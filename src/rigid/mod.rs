@@ -255,6 +255,13 @@ impl Inertia {
         (tensor, scaled(self.inverse) * rt)
     }
 
+    /// The largest inverse principal moment (1/(kg·m²)): the bound on how fast a unit torque
+    /// about any axis turns the body.
+    #[must_use]
+    pub(crate) fn max_inverse_moment(&self) -> f32 {
+        self.inverse.max_element()
+    }
+
     /// True for infinite inertia (a body torques cannot turn).
     #[must_use]
     pub fn is_infinite(&self) -> bool {

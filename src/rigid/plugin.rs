@@ -194,7 +194,9 @@ fn integrate_angular_momenta(
                 q.0 = turn(q.0, l.0, w.0, inertia, h, *update, false);
                 l.bypass_change_detection().0 = kick(l.0, 1.0);
             }
-            Integrator::SymplecticEuler => l.bypass_change_detection().0 = kick(l.0, 1.0),
+            Integrator::SymplecticEuler | Integrator::ImplicitEuler => {
+                l.bypass_change_detection().0 = kick(l.0, 1.0);
+            }
             Integrator::VelocityVerlet => l.bypass_change_detection().0 = kick(l.0, 0.5),
             Integrator::Rk4 => {}
         }
@@ -223,7 +225,7 @@ fn integrate_orientations(
         let method = o.map_or(*global, |o| o.0);
         if matches!(
             method,
-            Integrator::SymplecticEuler | Integrator::VelocityVerlet
+            Integrator::SymplecticEuler | Integrator::VelocityVerlet | Integrator::ImplicitEuler
         ) {
             let strang = method == Integrator::VelocityVerlet;
             q.0 = turn(q.0, l.0, w.0, inertia, h, *update, strang);

@@ -58,6 +58,8 @@ impl WorldPlugin for SoftBodyPlugin {
             world,
             PhysicsSchedule,
             (
+                crate::integrator::follow_implicit_dial::<SoftBody>
+                    .run_if(any_with_component::<SoftBody>),
                 super::targets::drive_node_targets.run_if(any_with_component::<super::NodeTargets>),
                 super::attach::anchor_attachments
                     .run_if(any_with_component::<super::NodeAttachments>),

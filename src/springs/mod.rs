@@ -31,6 +31,7 @@
 //!   instead of looking entities up.
 
 mod builders;
+mod entity_implicit;
 mod implicit;
 mod plugin;
 pub mod stability;
@@ -38,7 +39,7 @@ pub mod stability;
 pub use builders::{Chain, ChainBuilder, ClothBuilder};
 pub use plugin::SpringPlugin;
 pub(crate) use plugin::{Endpoint, Spinning, anchor_state};
-pub use stability::{EntitySpringStability, SpringStability, StabilityWarning};
+pub use stability::{EntitySpringStability, SpringStability, StabilityPolicy, StabilityWarning};
 
 use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;

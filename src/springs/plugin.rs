@@ -32,6 +32,15 @@ impl WorldPlugin for SpringPlugin {
                 .chain()
                 .in_set(ForceSystems::Springs)
         });
+        // Substeps only: the multistage integrators' stage re-evaluations never see it (its
+        // ends kick then drift).
+        add_systems(
+            world,
+            crate::schedule::SubstepSchedule,
+            super::entity_implicit::solve_entity_springs
+                .run_if(any_with_component::<Spring>)
+                .in_set(ForceSystems::ImplicitSprings),
+        );
         add_systems(
             world,
             crate::schedule::SubstepSchedule,
@@ -40,15 +49,22 @@ impl WorldPlugin for SpringPlugin {
                 .in_set(crate::schedule::ImplicitSystems::Springs),
         );
         world.init_resource::<super::EntitySpringStability>();
+        world.init_resource::<super::StabilityPolicy>();
         world.init_resource::<bevy_ecs::message::Messages<super::StabilityWarning>>();
         add_systems(
             world,
             PhysicsSchedule,
             (
                 remove_broken_springs.run_if(any_with_component::<Spring>),
-                super::stability::check_stability.run_if(
-                    any_with_component::<Spring>.or_else(any_with_component::<SpringNetwork>),
-                ),
+                crate::integrator::follow_implicit_dial::<SpringNetwork>
+                    .run_if(any_with_component::<SpringNetwork>),
+                // It reads only the meshes' masses (positions do not enter the limit), so its
+                // order against other inputs that move nodes does not change any result.
+                super::stability::check_stability
+                    .run_if(
+                        any_with_component::<Spring>.or_else(any_with_component::<SpringNetwork>),
+                    )
+                    .ambiguous_with_all(),
             )
                 .chain()
                 .in_set(PrepareSystems::Inputs),
@@ -87,14 +103,26 @@ pub(crate) fn anchor_state(
 fn apply_spring_forces(
     mut commands: Commands,
     guard: Res<crate::quarantine::DivergenceGuard>,
-    springs: Query<(Entity, &Spring), Live>,
+    global: Res<crate::Integrator>,
+    springs: Query<(Entity, &Spring, Has<crate::ImplicitEuler>), Live>,
     states: Query<Endpoint, Live>,
+    ends: Query<super::entity_implicit::EndBody, Live>,
     spinning: Query<Spinning, Live>,
     mut forces: Query<&mut Force, Live>,
     mut torques: Query<&mut Torque, Live>,
     masses: Query<&crate::particles::Mass>,
 ) {
-    for (spring, s) in &springs {
+    let global = *global;
+    for (spring, s, flagged) in &springs {
+        if super::entity_implicit::wants_implicit(global, flagged) {
+            let accepts = |e: Entity| {
+                ends.get(e)
+                    .is_ok_and(|(_, _, m, o)| super::entity_implicit::end_accepts(global, m, o))
+            };
+            if accepts(s.a) && accepts(s.b) {
+                continue;
+            }
+        }
         // A quarantined or missing endpoint drops out of the query, so NaN can't cross.
         let (Ok(ea), Ok(eb)) = (states.get(s.a), states.get(s.b)) else {
             continue;

@@ -19,6 +19,15 @@
 //! substeps it needs, and [`crate::PhysicsDiagnostics::stability_warnings`] counts it.
 //! Past the limit the springs diverge within a few steps, and [`crate::DivergenceGuard`]
 //! quarantines what runs away.
+//!
+//! **[`StabilityPolicy`]** decides what happens to such a system. The default,
+//! [`StabilityPolicy::SwitchToImplicit`], puts an [`ImplicitEuler`] on it (the mesh entity,
+//! or each [`Spring`] entity touching a node past its limit) so it is solved by backward
+//! Euler from that step on, stable at any stiffness: a game developer's stiff rope just
+//! works at 60 Hz. It acts on systems integrated by [`Integrator::SymplecticEuler`] (the
+//! default); a system given another integrator on purpose keeps it and is only warned, as
+//! under [`StabilityPolicy::Warn`]. The warning says which happened
+//! ([`StabilityWarning::solved_implicitly`]).
 
 use std::collections::HashMap;
 
@@ -26,7 +35,7 @@ use bevy_ecs::prelude::*;
 
 use super::{Spring, SpringNetwork};
 use crate::diagnostics::PhysicsDiagnostics;
-use crate::integrator::ImplicitEuler;
+use crate::integrator::{ImplicitEuler, Integrator, IntegratorOverride};
 use crate::particles::{Mass, Nodes};
 use crate::time::PhysicsTime;
 
@@ -49,6 +58,23 @@ pub struct EntitySpringStability {
     /// The spring at the node with the highest frequency.
     pub spring: Option<Entity>,
     warned: bool,
+    /// How many springs were solved implicitly when the limit was computed, and the substep
+    /// it was computed for: a change in either recomputes it.
+    implicit: usize,
+    substep: f32,
+}
+
+/// What hooke does with a spring system whose explicit stability limit is below the substep
+/// (see [`crate::springs::stability`]). A resource.
+#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum StabilityPolicy {
+    /// Solve it with backward Euler from then on ([`ImplicitEuler`] is inserted on it), and
+    /// write a [`StabilityWarning`] saying so. The default.
+    #[default]
+    SwitchToImplicit,
+    /// Keep integrating it explicitly and write a [`StabilityWarning`]; the
+    /// [`crate::DivergenceGuard`] catches what then runs away.
+    Warn,
 }
 
 /// Written once per spring system whose explicit stability limit is below the substep.
@@ -62,16 +88,25 @@ pub struct StabilityWarning {
     pub substep: f32,
     /// Substeps per step that would keep it stable under the explicit integrators.
     pub substeps_needed: u32,
+    /// Whether [`StabilityPolicy::SwitchToImplicit`] switched it to backward Euler.
+    pub solved_implicitly: bool,
 }
 
 impl StabilityWarning {
     /// The advice, as a sentence.
     #[must_use]
     pub fn advice(&self) -> String {
-        format!(
-            "spring system {:?} is unstable under explicit integration: substep {:.2e} s > its limit {:.2e} s; use {} substeps",
-            self.entity, self.substep, self.critical_step, self.substeps_needed
-        )
+        if self.solved_implicitly {
+            format!(
+                "spring system {:?} is too stiff for explicit integration (substep {:.2e} s > its limit {:.2e} s): it is solved by backward Euler from now on; {} substeps would keep it explicit",
+                self.entity, self.substep, self.critical_step, self.substeps_needed
+            )
+        } else {
+            format!(
+                "spring system {:?} is unstable under explicit integration: substep {:.2e} s > its limit {:.2e} s; use {} substeps or backward Euler (ImplicitEuler)",
+                self.entity, self.substep, self.critical_step, self.substeps_needed
+            )
+        }
     }
 }
 
@@ -117,10 +152,14 @@ impl SpringNetwork {
     }
 }
 
-/// Recomputes the limits that springs or masses changed, and warns once per system past it.
-#[allow(clippy::type_complexity)] // the change filters are the point
+/// Recomputes the limits that springs or masses changed, and warns once per system past it
+/// (switching it to backward Euler under [`StabilityPolicy::SwitchToImplicit`]).
+#[allow(clippy::type_complexity, clippy::too_many_arguments)] // the change filters are the point
 pub(crate) fn check_stability(
+    mut commands: Commands,
     time: Res<PhysicsTime>,
+    global: Res<Integrator>,
+    policy: Option<Res<StabilityPolicy>>,
     mut meshes: Query<
         (
             Entity,
@@ -128,87 +167,133 @@ pub(crate) fn check_stability(
             Ref<SpringNetwork>,
             &mut SpringStability,
             Has<ImplicitEuler>,
+            Option<&IntegratorOverride>,
         ),
         Without<crate::quarantine::Quarantined>,
     >,
-    springs: Query<(Entity, Ref<Spring>)>,
-    masses: Query<Ref<Mass>>,
+    springs: Query<(Entity, Ref<Spring>, Has<ImplicitEuler>)>,
+    masses: Query<(Ref<Mass>, Option<&IntegratorOverride>)>,
+    inertias: Query<&crate::rigid::Inertia>,
     mut entity_limit: ResMut<EntitySpringStability>,
     mut warnings: MessageWriter<StabilityWarning>,
     mut diag: Option<ResMut<PhysicsDiagnostics>>,
 ) {
+    let global = *global;
+    let switch = policy.is_none_or(|p| *p == StabilityPolicy::SwitchToImplicit);
     let substep = time.dt() / time.substeps() as f32;
     let needed = |h_crit: f32| ((time.dt() / (0.9 * h_crit)).ceil() as u32).max(1);
     let mut smallest = f32::INFINITY;
-    let mut warn = |entity: Entity, h_crit: f32, diag: &mut Option<ResMut<PhysicsDiagnostics>>| {
+    let mut warn = |entity: Entity,
+                    h_crit: f32,
+                    solved_implicitly: bool,
+                    diag: &mut Option<ResMut<PhysicsDiagnostics>>| {
         warnings.write(StabilityWarning {
             entity,
             critical_step: h_crit,
             substep,
             substeps_needed: needed(h_crit),
+            solved_implicitly,
         });
         if let Some(d) = diag {
             d.stability_warnings += 1;
         }
     };
-    for (e, nodes, network, mut stability, implicit) in &mut meshes {
+    let implicit_dial = global == Integrator::ImplicitEuler;
+    for (e, nodes, network, mut stability, implicit, o) in &mut meshes {
         if !stability.computed || nodes.is_changed() || network.is_changed() {
             stability.critical_step = network.critical_step(&nodes);
             stability.computed = true;
         }
         smallest = smallest.min(stability.critical_step);
-        // (`ImplicitEuler` on a spring mesh is reserved for the implicit spring solve.)
-        if !implicit && !stability.warned && substep > stability.critical_step {
+        if !implicit && !implicit_dial && !stability.warned && substep > stability.critical_step {
             stability.warned = true;
-            warn(e, stability.critical_step, &mut diag);
+            let method = o.map_or(global, |o| o.0);
+            let solved_implicitly = switch && method == Integrator::SymplecticEuler;
+            if solved_implicitly {
+                commands.entity(e).insert(ImplicitEuler::default());
+            }
+            warn(e, stability.critical_step, solved_implicitly, &mut diag);
         }
     }
+    // The entity springs integrated explicitly; the implicit ones have no limit.
+    let explicit = |flagged: bool| !super::entity_implicit::wants_implicit(global, flagged);
+    let implicit_count = springs.iter().filter(|s| !explicit(s.2)).count();
     let changed = !springs.is_empty()
-        && (springs.iter().any(|(_, s)| s.is_changed())
-            || masses.iter().any(|m| m.is_changed())
-            || entity_limit.spring.is_none());
+        && (springs.iter().any(|(_, s, _)| s.is_changed())
+            || masses.iter().any(|m| m.0.is_changed())
+            || entity_limit.spring.is_none()
+            || entity_limit.implicit != implicit_count
+            || entity_limit.substep != substep);
     if changed {
-        let mut rows: HashMap<Entity, (f32, f32)> = HashMap::new();
-        let inverse = |e: Entity| masses.get(e).map_or(0.0, |m| m.inverse());
-        for (_, s) in &springs {
-            let (wa, wb) = (inverse(s.a()), inverse(s.b()));
+        entity_limit.implicit = implicit_count;
+        entity_limit.substep = substep;
+        // Per end (a body, and an anchor on it): its stiffness row, damping sum and inverse
+        // mass. An anchor at lever r on a rigid body moves under a force as fast as a mass
+        // 1/(1/m + |r|²/I_min) would (the angular response bounded, as in the implicit solve).
+        let mut rows: HashMap<(Entity, [u32; 3]), (f32, f32, f32)> = HashMap::new();
+        let inverse = |e: Entity, anchor: glam::Vec3| {
+            let w = masses.get(e).map_or(0.0, |m| m.0.inverse());
+            match inertias.get(e) {
+                Ok(i) if w > 0.0 => w + anchor.length_squared() * i.max_inverse_moment(),
+                _ => w,
+            }
+        };
+        let key = |e: Entity, a: glam::Vec3| (e, a.to_array().map(f32::to_bits));
+        for (_, s, _) in springs.iter().filter(|s| explicit(s.2)) {
+            let (anchor_a, anchor_b) = s.anchors();
+            let (wa, wb) = (inverse(s.a(), anchor_a), inverse(s.b(), anchor_b));
             let cross = (wa * wb).sqrt();
-            for (end, w) in [(s.a(), wa), (s.b(), wb)] {
+            for (end, w) in [(key(s.a(), anchor_a), wa), (key(s.b(), anchor_b), wb)] {
                 if w > 0.0 {
                     let row = rows.entry(end).or_default();
                     row.0 += s.stiffness() * (w + cross);
                     row.1 += s.damping();
+                    row.2 = w;
                 }
             }
         }
+        let node_limit = |end: (Entity, [u32; 3])| {
+            rows.get(&end)
+                .map(|&(kk, cc, w)| limit([(kk, cc, 1.0 / w)].into_iter()))
+        };
         let mut best = (f32::INFINITY, None);
-        for (_, s) in &springs {
-            for end in [s.a(), s.b()] {
-                if let Some(&(kk, cc)) = rows.get(&end) {
-                    let h = limit([(kk, cc, 1.0 / inverse(end))].into_iter());
+        let mut stiff = Vec::new();
+        for (e, s, _) in springs.iter().filter(|s| explicit(s.2)) {
+            let mut over = false;
+            let (anchor_a, anchor_b) = s.anchors();
+            for end in [key(s.a(), anchor_a), key(s.b(), anchor_b)] {
+                if let Some(h) = node_limit(end) {
+                    over |= substep > h;
                     if h < best.0 {
-                        best = (h, Some(end));
+                        best = (h, Some(e));
                     }
                 }
             }
+            // Under the policy, a spring touching a node past its limit is switched, when
+            // both its ends are integrated by symplectic Euler.
+            let symplectic = |end: Entity| {
+                masses.get(end).is_ok_and(|(m, o)| {
+                    m.is_pinned() || o.map_or(global, |o| o.0) == Integrator::SymplecticEuler
+                })
+            };
+            if over && switch && symplectic(s.a()) && symplectic(s.b()) {
+                stiff.push(e);
+            }
         }
-        let spring = best.1.and_then(|end| {
-            springs
-                .iter()
-                .find(|(_, s)| s.a() == end || s.b() == end)
-                .map(|(e, _)| e)
-        });
         entity_limit.critical_step = best.0;
-        entity_limit.spring = spring;
+        entity_limit.spring = best.1;
+        if let Some(spring) = best.1
+            && !entity_limit.warned
+            && substep > best.0
+        {
+            entity_limit.warned = true;
+            warn(spring, best.0, stiff.contains(&spring), &mut diag);
+        }
+        for e in stiff {
+            commands.entity(e).insert(ImplicitEuler::default());
+        }
     }
     smallest = smallest.min(entity_limit.critical_step);
-    if let Some(spring) = entity_limit.spring
-        && !entity_limit.warned
-        && substep > entity_limit.critical_step
-    {
-        entity_limit.warned = true;
-        warn(spring, entity_limit.critical_step, &mut diag);
-    }
     if let Some(d) = diag.as_mut() {
         d.spring_critical_step = smallest;
     }

@@ -1,0 +1,303 @@
+//! Backward Euler for `Spring` entities (ropes from `ChainBuilder`, springs on rigid bodies),
+//! through the global dial (`Integrator::ImplicitEuler`), a per-spring `ImplicitEuler`, and
+//! the default `StabilityPolicy`, against closed forms.
+
+mod common;
+
+use bevy_ecs::message::Messages;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use hooke::prelude::*;
+use hooke::{
+    ChainBuilder, ImplicitEuler, PhysicsTime, Quarantined, StabilityPolicy, StabilityWarning,
+    scenes,
+};
+
+fn warnings(w: &World) -> Vec<StabilityWarning> {
+    let m = w.resource::<Messages<StabilityWarning>>();
+    m.get_cursor().read(m).cloned().collect()
+}
+
+/// Kinetic (translational and rotational), gravitational and spring energy (J).
+fn total_energy(w: &World) -> f64 {
+    let d = w.resource::<PhysicsDiagnostics>();
+    d.kinetic_energy + d.gravitational_energy + d.spring_energy
+}
+
+#[test]
+fn the_implicit_dial_on_the_unit_oscillator_matches_backward_euler_and_is_first_order() {
+    let h = 1.0 / 60.0;
+    let (mut w, body) = common::oscillator(h, Integrator::ImplicitEuler, 0.0);
+    let e0 = common::oscillator_energy(&w, body);
+    for _ in 0..600 {
+        w.step_physics();
+    }
+    let ratio = common::oscillator_energy(&w, body) / e0;
+    let omega2 = 4.0 * std::f64::consts::PI.powi(2);
+    let closed = (1.0 / (1.0 + omega2 * f64::from(h).powi(2))).powi(600);
+    println!(
+        "entity spring, implicit dial: energy after 10 periods x{ratio:.5} (closed x{closed:.5})"
+    );
+    assert!((ratio / closed - 1.0).abs() < 0.02, "{ratio} vs {closed}");
+    assert!((ratio - 0.0014).abs() < 0.0002);
+
+    let error_at = |h: f32| {
+        let (mut w, body) = common::oscillator(h, Integrator::ImplicitEuler, 0.0);
+        for _ in 0..(0.3 / h).round() as usize {
+            w.step_physics();
+        }
+        (common::x(&w, body).x - (common::TWO_PI * 0.3).cos()).abs()
+    };
+    let (coarse, fine) = (error_at(0.3 / 60.0), error_at(0.3 / 120.0));
+    let order = (coarse / fine).log2();
+    println!("error at t = 0.3 s: {coarse:.2e} -> {fine:.2e}, order {order:.2}");
+    assert!((order - 1.0).abs() < 0.15, "{order}");
+}
+
+#[test]
+fn one_backward_euler_step_of_a_particle_is_exact() {
+    // v₁ = (v₀ − h ω² x₀) / (1 + h² ω²), x₁ = x₀ + h v₁ for x₀ = 1, v₀ = 0.
+    let h = 0.1f64;
+    let (mut w, body) = common::oscillator(h as f32, Integrator::ImplicitEuler, 0.0);
+    w.step_physics();
+    let omega2 = 4.0 * std::f64::consts::PI.powi(2);
+    let v1 = -h * omega2 / (1.0 + h * h * omega2);
+    let x1 = 1.0 + h * v1;
+    let (x, v) = (common::x(&w, body).x, common::v(&w, body).x);
+    println!("one step: x {x} (closed {x1:.6}), v {v} (closed {v1:.6})");
+    assert!((f64::from(v) - v1).abs() < 1e-4 * v1.abs(), "{v} vs {v1}");
+    assert!((f64::from(x) - x1).abs() < 1e-5, "{x} vs {x1}");
+}
+
+/// A 20-node rope whose top segment stretches 0.1 % under the rope's weight: k ≈ 3.7e5 N/m,
+/// needing 36 substeps explicitly.
+fn stiff_rope() -> ChainBuilder {
+    let weight = 20.0 * 0.1 * 9.81;
+    ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0), 20)
+        .stiffness(weight / (1e-3 / 19.0))
+}
+
+fn default_world() -> World {
+    let mut w = World::new();
+    w.add_physics(PhysicsPlugins);
+    w
+}
+
+#[test]
+fn a_stiff_rope_just_works_at_the_defaults_the_policy_switches_it_to_backward_euler() {
+    let mut w = default_world();
+    assert_eq!(
+        *w.resource::<StabilityPolicy>(),
+        StabilityPolicy::SwitchToImplicit
+    );
+    let rope = stiff_rope().spawn(&mut w).unwrap();
+    w.step_physics();
+    let told = warnings(&w);
+    assert_eq!(told.len(), 1, "{told:?}");
+    assert!(told[0].solved_implicitly);
+    println!("{}", told[0].advice());
+    for &s in &rope.springs {
+        assert!(
+            w.get::<ImplicitEuler>(s).is_some(),
+            "every segment is switched"
+        );
+    }
+    // 10 s at 60 Hz, 4 substeps: released horizontal, it swings down and keeps swinging (its
+    // damping acts along the springs only), never gaining energy and never stretching far.
+    let e0 = total_energy(&w);
+    let mut most = f64::NEG_INFINITY;
+    let mut strain = 0.0f32;
+    for _ in 0..600 {
+        w.step_physics();
+        most = most.max(total_energy(&w) - e0);
+        for &s in &rope.springs {
+            strain = strain.max(w.get::<Spring>(s).unwrap().reading(&w).unwrap().strain);
+        }
+    }
+    let d = w.resource::<PhysicsDiagnostics>();
+    println!(
+        "swinging stiff rope, 10 s: energy gain at most {most:.3e} J, largest strain {strain:.2e}"
+    );
+    assert_eq!(d.quarantined_total, 0);
+    assert_eq!(d.stability_warnings, 1);
+    assert!(most < 1e-3 * e0.abs().max(1.0), "{most} J gained");
+    assert!(strain < 0.01, "{strain}");
+}
+
+#[test]
+fn a_stiff_rope_hung_straight_comes_to_rest_with_each_spring_carrying_the_weight_below() {
+    let mut w = default_world();
+    let rope = ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.0, 1.0, 0.0), 20)
+        .stiffness(20.0 * 0.1 * 9.81 / (1e-3 / 19.0))
+        .spawn(&mut w)
+        .unwrap();
+    for _ in 0..300 {
+        w.step_physics();
+    }
+    assert_eq!(w.resource::<PhysicsDiagnostics>().quarantined_total, 0);
+    let speed = rope
+        .nodes
+        .iter()
+        .map(|&n| common::v(&w, n).length())
+        .fold(0.0f32, f32::max);
+    println!("hung straight, after 5 s: fastest node {speed:.2e} m/s");
+    assert!(speed < 1e-3, "comes to rest: {speed} m/s");
+    for (i, &s) in rope.springs.iter().enumerate() {
+        let r = w.get::<Spring>(s).unwrap().reading(&w).unwrap();
+        let below = (19 - i) as f32 * 0.1 * 9.81;
+        assert!(
+            (r.tension / below - 1.0).abs() < 0.02,
+            "spring {i}: {} N vs {below} N",
+            r.tension
+        );
+    }
+}
+
+#[test]
+fn under_the_warn_policy_the_stiff_rope_stays_explicit_and_the_guard_catches_it() {
+    let mut w = default_world();
+    w.insert_resource(StabilityPolicy::Warn);
+    let rope = stiff_rope().spawn(&mut w).unwrap();
+    w.step_physics();
+    let told = warnings(&w);
+    assert_eq!(told.len(), 1);
+    assert!(!told[0].solved_implicitly);
+    for _ in 0..4 {
+        w.step_physics();
+    }
+    assert!(
+        rope.springs
+            .iter()
+            .all(|&s| w.get::<ImplicitEuler>(s).is_none())
+    );
+    assert!(
+        rope.nodes
+            .iter()
+            .any(|&n| w.get::<Quarantined>(n).is_some())
+    );
+}
+
+#[test]
+fn a_spring_marked_implicit_is_solved_so_even_under_the_warn_policy() {
+    let mut w = default_world();
+    w.insert_resource(StabilityPolicy::Warn);
+    let rope = stiff_rope().spawn(&mut w).unwrap();
+    for &s in &rope.springs {
+        w.entity_mut(s).insert(ImplicitEuler::default());
+    }
+    for _ in 0..120 {
+        w.step_physics();
+    }
+    assert!(warnings(&w).is_empty(), "an implicit spring has no limit");
+    assert_eq!(w.resource::<PhysicsDiagnostics>().quarantined_total, 0);
+    let bottom = common::x(&w, *rope.nodes.last().unwrap());
+    assert!(bottom.is_finite() && bottom.length() < 3.5, "{bottom}");
+}
+
+/// A box of `m` kg and half extents `h` at `x`, without a collider.
+fn box_body(m: f32, h: Vec3, x: Vec3) -> RigidBodyBundle {
+    let i = |a: f32, b: f32| m / 3.0 * (a * a + b * b);
+    let inertia = Inertia::diagonal(i(h.y, h.z), i(h.x, h.z), i(h.x, h.y)).unwrap();
+    RigidBodyBundle::dynamic(MassProperties::new(m, Vec3::ZERO, inertia).unwrap())
+        .unwrap()
+        .at(x)
+        .unwrap()
+}
+
+#[test]
+fn a_rigid_box_on_a_stiff_spring_at_its_centre_hangs_at_the_static_stretch() {
+    // 10 kg box on a 1 m spring of 3.6e6 N/m from a pin: ω = 600 rad/s, ωh = 2.5 at 240 Hz
+    // (explicitly unstable). Static stretch g / ω² = 2.725e-5 m.
+    let mut w = default_world();
+    let pin = w.spawn(ParticleBundle::pinned(Vec3::ZERO).unwrap()).id();
+    let body = w
+        .spawn(box_body(10.0, Vec3::splat(0.1), Vec3::new(0.0, -1.0, 0.0)))
+        .id();
+    Spring::from_hooke(pin, body, 1.0, 3.6e6, 0.0)
+        .unwrap()
+        .spawn(&mut w)
+        .unwrap();
+    w.step_physics();
+    let told = warnings(&w);
+    assert_eq!(told.len(), 1);
+    assert!(told[0].solved_implicitly);
+    let mut farthest = 0.0f32;
+    for _ in 0..600 {
+        w.step_physics();
+        farthest = farthest.max(common::x(&w, body).length());
+    }
+    let x = common::x(&w, body);
+    let stretch = -x.y - 1.0;
+    println!(
+        "box: swung to {farthest:.5} m from the pin; rests at {x}, stretch {stretch:.3e} m (closed 2.725e-5)"
+    );
+    assert!(
+        farthest < 1.001,
+        "the spring never stretched past 1 mm: {farthest}"
+    );
+    assert!(x.x.abs() < 0.01, "{x}");
+    assert!((stretch / 2.725e-5 - 1.0).abs() < 0.03, "{stretch}");
+}
+
+#[test]
+fn a_box_hung_off_centre_by_a_stiff_spring_swings_without_gaining_energy() {
+    // The spring holds a corner, 0.41 m from the centre: the box's angular response matters
+    // (the corner moves 2.6 times as far under a force as the centre would). Released at
+    // the spring's rest length, 37 degrees off the vertical.
+    let mut w = default_world();
+    let pin = w
+        .spawn(ParticleBundle::pinned(Vec3::new(0.0, 5.0, 0.0)).unwrap())
+        .id();
+    let body = w
+        .spawn(box_body(
+            10.0,
+            Vec3::new(0.4, 0.1, 0.1),
+            Vec3::new(0.2, 4.1, 0.0),
+        ))
+        .id();
+    let corner = Vec3::new(0.4, 0.1, 0.0);
+    let spring = Spring::from_hooke(pin, body, 1.0, 1e6, 50.0)
+        .unwrap()
+        .with_anchors(Vec3::ZERO, corner)
+        .unwrap()
+        .spawn(&mut w)
+        .unwrap();
+    w.step_physics();
+    let e0 = total_energy(&w);
+    let told = warnings(&w);
+    assert_eq!(told.len(), 1, "the lever arm lowers the limit: {told:?}");
+    assert!(told[0].solved_implicitly);
+    let (mut most, mut strain) = (f64::NEG_INFINITY, 0.0f32);
+    for _ in 0..1200 {
+        w.step_physics();
+        most = most.max(total_energy(&w) - e0);
+        let r = w.get::<Spring>(spring).unwrap().reading(&w).unwrap();
+        strain = strain.max(r.strain.abs());
+    }
+    assert_eq!(w.resource::<PhysicsDiagnostics>().quarantined_total, 0);
+    let e = total_energy(&w) - e0;
+    println!(
+        "off-centre box, 20 s: energy gain at most {most:.3} J, at the end {e:.2} J; largest strain {strain:.2e}"
+    );
+    // Backward Euler only removes energy; 0.5 J is the f32 rounding of a 400 J total.
+    assert!(most < 0.5, "{most} J gained");
+    assert!(e < -10.0, "the swing is damped: {e} J");
+    assert!(strain < 2e-3, "{strain}");
+}
+
+#[test]
+fn leaving_the_implicit_dial_takes_the_dials_solver_off_the_meshes() {
+    let mut w = scenes::world_with(1.0 / 60.0, 1, Integrator::ImplicitEuler, Vec3::ZERO).unwrap();
+    let mut nodes = Nodes::new();
+    nodes.push_pinned(Vec3::ZERO).unwrap();
+    nodes.push(Vec3::X, Vec3::ZERO, 1.0).unwrap();
+    let mut net = SpringNetwork::new();
+    net.push(0, 1, 0.0, 10.0, 0.0).unwrap();
+    let mesh = w.spawn((nodes, net)).id();
+    w.step_physics();
+    assert!(w.get::<ImplicitEuler>(mesh).is_some());
+    *w.resource_mut::<Integrator>() = Integrator::SymplecticEuler;
+    w.step_physics();
+    assert!(w.get::<ImplicitEuler>(mesh).is_none());
+    let _ = w.resource::<PhysicsTime>();
+}
