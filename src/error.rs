@@ -54,6 +54,14 @@ pub enum Error {
         /// Its signed rest volume (m³).
         volume: f32,
     },
+    /// A triangle of a cloth mesh has repeated corners or (almost) no area.
+    #[error("triangle {index} is degenerate (rest area {area} m²)")]
+    DegenerateTriangle {
+        /// Which triangle.
+        index: usize,
+        /// Its rest area (m²).
+        area: f32,
+    },
     /// A quantity was outside its allowed range.
     #[error("{what} must satisfy {range}, got {value}")]
     OutOfRange {

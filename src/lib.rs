@@ -39,6 +39,7 @@
 //! | [`CollisionPlugin`] | broad and narrow phase, contact solver, contact messages, [`SpatialQuery`], mass from colliders, child colliders | [`Collider`] |
 //! | [`SleepPlugin`] | resting islands stop costing anything | [`Collider`] bodies |
 //! | [`soft::SoftBodyPlugin`] | tetrahedral FEM: elastic forces of the four strain models | [`soft::SoftBody`] |
+//! | [`cloth::ClothPlugin`] | wind on triangles, strain limiting, node collisions, vertex normals | [`cloth::Cloth`] |
 //!
 //! With the `bevy` feature, [`PhysicsPlugins`] is also a Bevy `PluginGroup`, every plugin above
 //! a Bevy `Plugin`, and [`bevy`] adds the App clock, `Transform` sync, interpolation and
@@ -139,6 +140,7 @@
 
 #[cfg(feature = "bevy")]
 pub mod bevy;
+pub mod cloth;
 pub mod collision;
 pub mod diagnostics;
 pub mod error;
@@ -160,6 +162,7 @@ pub use parry3d;
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 
+pub use cloth::{Cloth, ClothBuilder, ClothMaterial, ClothPlugin};
 pub use collision::{
     Collider, ColliderDensity, ColliderOf, ColliderOffset, CollisionEventsEnabled, CollisionLayers,
     CollisionPlugin, CombineRule, ContactEnd, ContactEnded, ContactSettings, ContactStart,
@@ -189,8 +192,8 @@ pub use schedule::{
 };
 pub use sleep::{SleepPlugin, SleepSettings, Sleeping, SleepingDisabled};
 pub use springs::{
-    Chain, ChainBuilder, ClothBuilder, EntitySpringStability, Spring, SpringNetwork, SpringPlugin,
-    SpringReading, SpringStability, StabilityPolicy, StabilityWarning,
+    Chain, ChainBuilder, EntitySpringStability, Spring, SpringNetwork, SpringPlugin, SpringReading,
+    SpringStability, StabilityPolicy, StabilityWarning,
 };
 pub use time::{FrameReport, PhysicsTime, SubstepTime};
 
@@ -270,7 +273,8 @@ impl WorldPlugin for PhysicsPlugins {
             .add_physics(RigidBodyPlugin)
             .add_physics(CollisionPlugin)
             .add_physics(SleepPlugin)
-            .add_physics(soft::SoftBodyPlugin);
+            .add_physics(soft::SoftBodyPlugin)
+            .add_physics(cloth::ClothPlugin);
     }
 }
 

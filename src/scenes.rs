@@ -4,9 +4,10 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
+use crate::cloth::ClothBuilder;
 use crate::error::Result;
 use crate::particles::{Gravity, ParticleBundle, Tracer, VelocityField};
-use crate::springs::{Chain, ChainBuilder, ClothBuilder, Spring};
+use crate::springs::{Chain, ChainBuilder, Spring};
 use crate::{Integrator, PhysicsPlugins, PhysicsTime, PhysicsWorldExt};
 
 /// A world with every plugin, the given step and integrator, and gravity `g`.

@@ -16,6 +16,7 @@
 //!   StepSystems::RelaxConstraints   contacts again without position bias (soft step)
 //!     RelaxSystems::Rigid             rigid contacts
 //!     RelaxSystems::Soft              soft-body attachments, then node contacts
+//!     RelaxSystems::Cloth             cloth strain limiting, then node contacts
 //!   StepSystems::CompleteStages     extra force evaluations of Verlet and RK4
 //!   StepSystems::Renormalize        unit quaternions
 //!
@@ -141,6 +142,8 @@ pub enum RelaxSystems {
     Rigid,
     /// Soft-body attachments, then soft-body node contacts.
     Soft,
+    /// Cloth strain limiting, then cloth node contacts.
+    Cloth,
 }
 
 /// The stages of [`PhysicsSystems::Prepare`]: user inputs first (kinematic targets, written
@@ -268,7 +271,7 @@ pub(crate) fn init_schedules(world: &mut World) {
             .in_set(IntegrationSystems::Integrate),
     );
     substep.configure_sets(
-        (RelaxSystems::Rigid, RelaxSystems::Soft)
+        (RelaxSystems::Rigid, RelaxSystems::Soft, RelaxSystems::Cloth)
             .chain()
             .in_set(StepSystems::RelaxConstraints),
     );

@@ -62,6 +62,8 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
 use bevy_time::{Fixed, Time};
 
+use crate::cloth::ClothPlugin;
+use crate::soft::SoftBodyPlugin;
 use crate::{
     BodyQuarantined, CollisionPlugin, ContactEnded, ContactStarted, DampingPlugin, GravityPlugin,
     PhysicsCorePlugin, PhysicsPlugins, PhysicsTime, PhysicsWorldExt, RigidBodyPlugin, SleepPlugin,
@@ -190,7 +192,9 @@ bevy_plugin!(
     SpringPlugin,
     RigidBodyPlugin,
     CollisionPlugin,
-    SleepPlugin
+    SleepPlugin,
+    SoftBodyPlugin,
+    ClothPlugin
 );
 
 /// `app.add_plugins(PhysicsPlugins)`: the clock ([`PhysicsSchedulePlugin`]), every effect,
@@ -208,6 +212,8 @@ impl PluginGroup for PhysicsPlugins {
             .add(RigidBodyPlugin)
             .add(CollisionPlugin)
             .add(SleepPlugin)
+            .add(SoftBodyPlugin)
+            .add(ClothPlugin)
             .add(PhysicsTransformPlugin)
             .add(PhysicsInterpolationPlugin)
     }

@@ -37,10 +37,12 @@
 
 mod attach;
 mod broad;
+pub(crate) mod coupling;
 mod exchange;
 mod fetch;
 mod lanes;
 mod narrow;
+pub(crate) mod nodes;
 mod plugin;
 mod query;
 mod solver;

@@ -37,6 +37,15 @@ impl WorldPlugin for CollisionPlugin {
         world.init_resource::<ContactSolver>();
         world.init_resource::<bevy_ecs::message::Messages<ContactStarted>>();
         world.init_resource::<bevy_ecs::message::Messages<ContactEnded>>();
+        // Impulses from mesh nodes (soft bodies, cloth) reach their bodies at the start of the
+        // next substep, before the bodies' own integrators.
+        add_systems(
+            world,
+            crate::schedule::SubstepSchedule,
+            super::coupling::apply_node_impulses
+                .run_if(any_with_component::<super::coupling::NodeImpulse>)
+                .in_set(crate::schedule::StepSystems::AccumulateTorque),
+        );
         world.add_observer(super::broad::on_body_inserted);
         world.add_observer(super::broad::on_body_removed);
         world.add_observer(super::attach::on_body_inserted);

@@ -30,8 +30,6 @@
 //! small strains match linear elasticity. Units: Pa for E, μ, λ, P; J/m³ for Ψ.
 
 mod attach;
-mod contact;
-mod coupling;
 mod implicit;
 mod io;
 pub mod mesh;
@@ -195,6 +193,16 @@ pub(crate) fn scatter_element_forces(f: &mut [Vec3A], t: [u32; 4], h: Mat3) {
 /// A node held outside a static or kinematic collider: the plane n·x ≥ d at the node's
 /// contact, moving with the collider over the next substep.
 pub(crate) type NodeContact = crate::integrator::implicit::ContactPlane;
+
+impl crate::collision::nodes::NodeLayer for SoftBody {
+    fn thickness(&self) -> f32 {
+        self.contact_thickness
+    }
+
+    fn contacts_mut(&mut self) -> &mut Vec<NodeContact> {
+        &mut self.contacts
+    }
+}
 
 impl SoftBody {
     /// The nodes and the body of `mesh` placed at `offset` (m), with masses lumped from the

@@ -32,13 +32,6 @@ impl WorldPlugin for SoftBodyPlugin {
                 .run_if(any_with_component::<ImplicitEuler>)
                 .in_set(crate::schedule::ImplicitSystems::SoftBodies),
         );
-        add_systems(
-            world,
-            SubstepSchedule,
-            super::coupling::apply_soft_impulses
-                .run_if(any_with_component::<super::coupling::SoftImpulse>)
-                .in_set(crate::schedule::StepSystems::AccumulateTorque),
-        );
         // Attachments first (chained: both move nodes), so that the contacts have the last
         // word on where a node may be.
         add_systems(
@@ -47,7 +40,7 @@ impl WorldPlugin for SoftBodyPlugin {
             (
                 super::attach::solve_attachments
                     .run_if(any_with_component::<super::NodeAttachments>),
-                super::contact::collide_nodes
+                crate::collision::nodes::collide_nodes::<SoftBody>
                     .run_if(any_with_component::<SoftBody>)
                     .run_if(any_with_component::<crate::collision::Collider>),
             )

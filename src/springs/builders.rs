@@ -3,9 +3,9 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
-use super::{Spring, SpringNetwork};
+use super::Spring;
 use crate::error::{Error, Result, finite_vec, non_negative, positive};
-use crate::particles::{Nodes, ParticleBundle};
+use crate::particles::ParticleBundle;
 
 /// A chain of particle entities joined by springs: a rope, or with bending springs (node i to
 /// node i + 2) a hair strand.
@@ -198,131 +198,6 @@ impl ChainBuilder {
             }
         }
         Ok(chain)
-    }
-}
-
-/// A rectangular cloth as one [`Nodes`] + [`SpringNetwork`]: structural springs to the four
-/// neighbours, shear springs on both diagonals and bending springs that skip one node.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ClothBuilder {
-    origin: Vec3,
-    nx: usize,
-    nz: usize,
-    spacing: f32,
-    node_mass: f32,
-    k_structural: f32,
-    k_shear: f32,
-    k_bend: f32,
-    damping: f32,
-    pin_corners: bool,
-}
-
-impl ClothBuilder {
-    /// A horizontal `nx` × `nz` cloth in the x–z plane starting at `origin`, nodes `spacing`
-    /// m apart, 0.01 kg per node, k = 8 / 4 / 1 N/m (structural / shear / bend),
-    /// c = 0.01 N·s/m, pinned at the two corners of its first row. A node feels about
-    /// 4(k_structural + k_shear + k_bend), so ω_max ≈ 2√(52/0.01) ≈ 144 rad/s: stable for
-    /// symplectic Euler at 60 Hz with 2 substeps or more.
-    #[must_use]
-    pub fn new(origin: Vec3, nx: usize, nz: usize, spacing: f32) -> Self {
-        Self {
-            origin,
-            nx,
-            nz,
-            spacing,
-            node_mass: 0.01,
-            k_structural: 8.0,
-            k_shear: 4.0,
-            k_bend: 1.0,
-            damping: 0.01,
-            pin_corners: true,
-        }
-    }
-
-    /// Stiffnesses (N/m) of the structural, shear and bending springs.
-    #[must_use]
-    pub fn stiffness(mut self, structural: f32, shear: f32, bend: f32) -> Self {
-        (self.k_structural, self.k_shear, self.k_bend) = (structural, shear, bend);
-        self
-    }
-
-    /// Whether the first row's two corners are pinned.
-    #[must_use]
-    pub fn pin_corners(mut self, pin: bool) -> Self {
-        self.pin_corners = pin;
-        self
-    }
-
-    /// Builds the arrays.
-    ///
-    /// # Errors
-    /// [`Error::TooFew`] for a side under 3 nodes; errors of the node and spring constructors.
-    pub fn build(&self) -> Result<(Nodes, SpringNetwork)> {
-        for n in [self.nx, self.nz] {
-            if n < 3 {
-                return Err(Error::TooFew {
-                    what: "cloth nodes per side",
-                    min: 3,
-                    got: n,
-                });
-            }
-        }
-        let s = positive("cloth spacing", self.spacing)?;
-        let (nx, nz) = (self.nx, self.nz);
-        let mut nodes = Nodes::with_capacity(nx * nz);
-        for j in 0..nz {
-            for i in 0..nx {
-                let x = self.origin + Vec3::new(i as f32 * s, 0.0, j as f32 * s);
-                nodes.push(x, Vec3::ZERO, self.node_mass)?;
-            }
-        }
-        if self.pin_corners {
-            nodes.pin(0)?;
-            nodes.pin(nx - 1)?;
-        }
-        let id = |i: usize, j: usize| j * nx + i;
-        let mut net = SpringNetwork::new();
-        let c = self.damping;
-        let diag = s * std::f32::consts::SQRT_2;
-        for j in 0..nz {
-            for i in 0..nx {
-                if i + 1 < nx {
-                    net.push(id(i, j), id(i + 1, j), s, self.k_structural, c)?;
-                }
-                if j + 1 < nz {
-                    net.push(id(i, j), id(i, j + 1), s, self.k_structural, c)?;
-                }
-                if i + 1 < nx && j + 1 < nz {
-                    net.push(id(i, j), id(i + 1, j + 1), diag, self.k_shear, c)?;
-                    net.push(id(i + 1, j), id(i, j + 1), diag, self.k_shear, c)?;
-                }
-                if i + 2 < nx {
-                    net.push(id(i, j), id(i + 2, j), 2.0 * s, self.k_bend, c)?;
-                }
-                if j + 2 < nz {
-                    net.push(id(i, j), id(i, j + 2), 2.0 * s, self.k_bend, c)?;
-                }
-            }
-        }
-        Ok((nodes, net))
-    }
-
-    /// Builds and spawns the cloth as one entity.
-    ///
-    /// # Errors
-    /// As [`ClothBuilder::build`].
-    pub fn spawn(&self, world: &mut World) -> Result<Entity> {
-        let (nodes, net) = self.build()?;
-        Ok(world.spawn((nodes, net)).id())
-    }
-
-    /// As [`ClothBuilder::spawn`], from a system's `Commands`.
-    ///
-    /// # Errors
-    /// As [`ClothBuilder::build`].
-    pub fn spawn_with(&self, commands: &mut Commands) -> Result<Entity> {
-        let (nodes, net) = self.build()?;
-        Ok(commands.spawn((nodes, net)).id())
     }
 }
 

@@ -36,7 +36,7 @@ mod implicit;
 mod plugin;
 pub mod stability;
 
-pub use builders::{Chain, ChainBuilder, ClothBuilder};
+pub use builders::{Chain, ChainBuilder};
 pub use plugin::SpringPlugin;
 pub(crate) use plugin::{Endpoint, Spinning, anchor_state};
 pub use stability::{EntitySpringStability, SpringStability, StabilityPolicy, StabilityWarning};

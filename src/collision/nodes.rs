@@ -1,7 +1,9 @@
-//! Soft-body nodes against colliders: point projection with a thickness and Coulomb
-//! friction, after the positions are integrated.
+//! Mesh nodes (soft bodies, cloth) against colliders: point projection with a thickness and
+//! Coulomb friction, after the positions are integrated. Each effect whose meshes collide
+//! implements [`NodeLayer`] for its component and registers [`collide_nodes`] for it.
 //!
-//! A node closer than [`SoftBody::contact_thickness`] to a collider's surface (or inside it)
+//! A node closer than the layer's thickness (e.g. [`crate::soft::SoftBody::contact_thickness`])
+//! to a collider's surface (or inside it)
 //! is moved out along the surface normal n to that distance; its velocity loses its
 //! approaching normal part Δvₙ, and its tangential part is reduced by μ Δvₙ (Coulomb's cone,
 //! μ the collider's [`crate::Friction`]), stopping it when the cone holds.
@@ -19,7 +21,7 @@
 //! takes −λ at each node. No plane holds a node to a dynamic body inside the solve: such a
 //! wall would not give, and a light body loaded with a heavy soft one's weight one substep
 //! late bounces off. The body takes its impulses at the start of the next substep
-//! ([`SoftImpulse`]), before its own integrator and rigid contacts.
+//! ([`NodeImpulse`]), before its own integrator and rigid contacts.
 //!
 //! **Known limit.** The rigid contacts are solved before the soft ones, not with them. A soft
 //! body resting on a light dynamic body that itself rests on others (a 27 kg jelly on a 10 kg
@@ -33,9 +35,9 @@ use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3, Vec3A};
 use parry3d::math::Pose;
 
-use super::SoftBody;
-use super::coupling::{RigidSide, SoftImpulse, move_soft, soft_response};
+use super::coupling::{NodeImpulse, RigidSide, move_soft, soft_response};
 use crate::collision::{Collider, ColliderAabb, ColliderOf, Friction};
+use crate::integrator::implicit::ContactPlane;
 use crate::integrator::skyline::SkylineCholesky;
 use crate::integrator::{ImplicitEuler, ImplicitState};
 use crate::particles::{LinearVelocity, Mass, Nodes, Position};
@@ -59,7 +61,7 @@ type ColliderPose<'a> = (
     &'a ColliderAabb,
     &'a Friction,
     Option<Dynamics<'a>>,
-    Option<&'a mut SoftImpulse>,
+    Option<&'a mut NodeImpulse>,
 );
 
 /// What a collider's body needs to take impulses.
@@ -70,9 +72,18 @@ type Dynamics<'a> = (
     &'a Inertia,
 );
 
-type Mesh<'a> = (
+/// A mesh whose nodes collide: its contact layer's thickness, and where the contacts of the
+/// last substep go (for its implicit solve to hold the nodes to).
+pub(crate) trait NodeLayer: Component<Mutability = bevy_ecs::component::Mutable> {
+    /// The layer's thickness (m): a node closer than this to a surface is in contact.
+    fn thickness(&self) -> f32;
+    /// The contacts found this substep.
+    fn contacts_mut(&mut self) -> &mut Vec<ContactPlane>;
+}
+
+type Mesh<'a, L> = (
     &'a mut Nodes,
-    &'a mut SoftBody,
+    &'a mut L,
     Option<&'a ImplicitState>,
     Option<&'a ImplicitEuler>,
 );
@@ -96,15 +107,15 @@ fn side_of(
 }
 
 /// Projects every soft body's nodes out of the colliders they touch.
-pub(crate) fn collide_nodes(
+pub(crate) fn collide_nodes<L: NodeLayer>(
     mut commands: Commands,
     time: Res<SubstepTime>,
-    mut bodies: Query<Mesh, Without<Quarantined>>,
+    mut bodies: Query<Mesh<L>, Without<Quarantined>>,
     mut colliders: Query<ColliderPose, (Without<Quarantined>, Without<ColliderOf>)>,
 ) {
     let h = time.h;
     // Bodies that get their first soft impulse this substep (inserted at its end).
-    let mut fresh: Vec<(Entity, SoftImpulse)> = Vec::new();
+    let mut fresh: Vec<(Entity, NodeImpulse)> = Vec::new();
     for (mut nodes, mut body, state, implicit) in &mut bodies {
         let body = body.bypass_change_detection();
         let n = nodes.bypass_change_detection();
@@ -112,8 +123,8 @@ pub(crate) fn collide_nodes(
             .filter(|_| implicit.is_some())
             .and_then(|s| s.factor.as_ref())
             .filter(|f| f.is_factored());
-        body.contacts.clear();
-        let thickness = body.contact_thickness;
+        body.contacts_mut().clear();
+        let thickness = body.thickness();
         let Some((lo, hi)) = n.bounds() else {
             continue;
         };
@@ -134,15 +145,15 @@ pub(crate) fn collide_nodes(
                 }
                 other => {
                     let side = other.map(|s| &*s);
-                    push_immovable(n, &mut body.contacts, side, &hits, friction.0, h);
+                    push_immovable(n, body.contacts_mut(), side, &hits, friction.0, h);
                 }
             }
             // The body takes the impulses at the start of the next substep (see
-            // `SoftImpulse`). Moving it now as well, as an attachment does, would push it,
+            // `NodeImpulse`). Moving it now as well, as an attachment does, would push it,
             // unseen, into whatever holds it up: the rigid contacts were found at the start
             // of the step.
             if let Some(side) = rigid.filter(RigidSide::touched) {
-                let add = SoftImpulse {
+                let add = NodeImpulse {
                     linear: side.linear,
                     angular: side.angular,
                 };
@@ -228,7 +239,7 @@ fn find_hits(
 /// the surface's velocity, and leaves a plane for the implicit solve.
 fn push_immovable(
     n: &mut Nodes,
-    contacts: &mut Vec<super::NodeContact>,
+    contacts: &mut Vec<ContactPlane>,
     side: Option<&RigidSide>,
     hits: &[Hit],
     mu: f32,
@@ -251,7 +262,7 @@ fn push_immovable(
             };
             n.v[i] = Vec3A::from(base + slowed);
         }
-        contacts.push(super::NodeContact {
+        contacts.push(ContactPlane {
             node: i as u32,
             normal: hit.normal,
             offset: hit.normal.dot(p) + h * hit.normal.dot(base),

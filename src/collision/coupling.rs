@@ -175,7 +175,7 @@ impl RigidSide {
 /// end of a step is then what its rigid contacts left (a crate under a jelly reads at rest),
 /// and whatever holds it up answers the push in the same substep.
 #[derive(Component, Debug, Clone, Copy, Default, PartialEq)]
-pub(crate) struct SoftImpulse {
+pub(crate) struct NodeImpulse {
     /// N·s, world frame.
     pub(crate) linear: Vec3,
     /// About the centre of mass (kg·m²/s, world frame).
@@ -183,7 +183,7 @@ pub(crate) struct SoftImpulse {
 }
 
 type Pending<'a> = (
-    &'a mut SoftImpulse,
+    &'a mut NodeImpulse,
     &'a mut LinearVelocity,
     &'a mut AngularMomentum,
     &'a mut AngularVelocity,
@@ -192,10 +192,10 @@ type Pending<'a> = (
     &'a Rotation,
 );
 
-/// Applies and clears [`SoftImpulse`]s: v += J/M, L += ΔL, ω = I⁻¹ L.
-pub(crate) fn apply_soft_impulses(mut bodies: Query<Pending, Without<Quarantined>>) {
+/// Applies and clears [`NodeImpulse`]s: v += J/M, L += ΔL, ω = I⁻¹ L.
+pub(crate) fn apply_node_impulses(mut bodies: Query<Pending, Without<Quarantined>>) {
     for (mut pending, mut v, mut l, mut w, m, i, q) in &mut bodies {
-        if *pending == SoftImpulse::default() {
+        if *pending == NodeImpulse::default() {
             continue;
         }
         let p = std::mem::take(pending.bypass_change_detection());
