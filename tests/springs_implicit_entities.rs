@@ -301,3 +301,123 @@ fn leaving_the_implicit_dial_takes_the_dials_solver_off_the_meshes() {
     assert!(w.get::<ImplicitEuler>(mesh).is_none());
     let _ = w.resource::<PhysicsTime>();
 }
+
+/// The hard-case catalogue at the defaults (60 Hz, 4 substeps, the default policy): each
+/// stays finite and bounded, never quarantined, and comes to rest.
+fn settles(name: &str, w: &mut World, nodes: &[Entity], seconds: f32, bound: f32) {
+    let steps = (seconds * 60.0) as usize;
+    let mut farthest = 0.0f32;
+    for _ in 0..steps {
+        w.step_physics();
+        for &n in nodes {
+            farthest = farthest.max(common::x(w, n).length());
+        }
+    }
+    let speed = nodes
+        .iter()
+        .map(|&n| common::v(w, n).length())
+        .fold(0.0f32, f32::max);
+    let d = w.resource::<PhysicsDiagnostics>();
+    println!(
+        "{name}: farthest node {farthest:.3} m, fastest after {seconds} s {speed:.2e} m/s, quarantined {}",
+        d.quarantined_total
+    );
+    assert_eq!(d.quarantined_total, 0, "{name}");
+    assert!(farthest < bound, "{name}: {farthest} m");
+    assert!(speed < 0.01, "{name}: still moving at {speed} m/s");
+}
+
+#[test]
+fn a_light_chain_holding_a_thousand_times_its_link_mass_settles() {
+    // 10 links of 1 kg, 10,000 kg at the end, k = 1e6 N/m and c = 2e5 N·s/m per link, hung
+    // straight down: the load drops about 1 m onto the chain (its bounce, 3.2 rad/s, is
+    // damped in about a second; it is the springs' 1e4 rad/s modes that need the implicit
+    // solve).
+    let mut w = default_world();
+    let chain = ChainBuilder::rope(Vec3::new(0.0, 5.0, 0.0), Vec3::new(0.0, 4.0, 0.0), 11)
+        .node_mass(1.0)
+        .stiffness(1e6)
+        .damping(2e5)
+        .end_load(1e4)
+        .spawn(&mut w)
+        .unwrap();
+    settles("1:1000 chain", &mut w, &chain.nodes, 10.0, 6.0);
+    let top = w
+        .get::<Spring>(chain.springs[0])
+        .unwrap()
+        .reading(&w)
+        .unwrap();
+    let below = (9.0 + 1.0 + 1e4) * 9.81;
+    println!(
+        "top link tension {:.0} N (weight below {below:.0} N)",
+        top.tension
+    );
+    assert!((top.tension / below - 1.0).abs() < 0.01);
+}
+
+#[test]
+fn a_taut_string_of_light_masses_pinned_at_both_ends_settles() {
+    // 30 nodes of 1 g over 1 m, pre-stretched 5 % between two pins, k = 1e5 N/m.
+    let mut w = default_world();
+    let string = ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0), 30)
+        .node_mass(0.001)
+        .stiffness(1e5)
+        .damping(0.05)
+        .pin_end(true)
+        .rest_scale(0.95)
+        .spawn(&mut w)
+        .unwrap();
+    settles("taut string", &mut w, &string.nodes, 5.0, 3.0);
+    let mid = common::x(&w, string.nodes[15]);
+    assert!((mid.y - 2.0).abs() < 1e-3, "barely sags: {mid}");
+}
+
+#[test]
+fn a_rope_whose_end_is_yanked_at_50_m_s_stays_finite_and_settles() {
+    let mut w = default_world();
+    let rope = stiff_rope().spawn(&mut w).unwrap();
+    let end = *rope.nodes.last().unwrap();
+    w.step_physics();
+    w.get_mut::<LinearVelocity>(end).unwrap().0 = glam::Vec3A::new(0.0, 50.0, 50.0);
+    let mut farthest = 0.0f32;
+    for _ in 0..600 {
+        w.step_physics();
+        for &n in &rope.nodes {
+            farthest = farthest.max(common::x(&w, n).length());
+        }
+    }
+    let d = w.resource::<PhysicsDiagnostics>();
+    println!(
+        "yanked rope: farthest node {farthest:.3} m, quarantined {}",
+        d.quarantined_total
+    );
+    assert_eq!(d.quarantined_total, 0);
+    // The rope is 1 m long from a pin at (0, 2, 0): no node gets past 3.1 m from the origin.
+    assert!(farthest < 3.1, "{farthest}");
+}
+
+#[test]
+fn very_stiff_springs_on_light_masses_settle() {
+    // 1 g beads on springs of 1e6 N/m (ω = 3e4 rad/s, 130 times the substep's limit).
+    let mut w = default_world();
+    let beads = ChainBuilder::rope(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.5, 1.0, 0.0), 6)
+        .node_mass(0.001)
+        .stiffness(1e6)
+        .damping(0.1)
+        .spawn(&mut w)
+        .unwrap();
+    let mut farthest = 0.0f32;
+    for _ in 0..600 {
+        w.step_physics();
+        for &n in &beads.nodes {
+            farthest = farthest.max(common::x(&w, n).length());
+        }
+    }
+    let d = w.resource::<PhysicsDiagnostics>();
+    println!(
+        "stiff beads: farthest {farthest:.3} m, quarantined {}",
+        d.quarantined_total
+    );
+    assert_eq!(d.quarantined_total, 0);
+    assert!(farthest < 1.6, "{farthest}");
+}
