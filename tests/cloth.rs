@@ -94,6 +94,17 @@ fn bad_cloth_meshes_are_typed_errors() {
 }
 
 #[test]
+fn absurd_builder_sizes_are_errors_not_allocation_panics() {
+    let huge = ClothBuilder::new(Vec3::ZERO, usize::MAX, 3, 0.1).build();
+    assert!(matches!(huge, Err(Error::OutOfRange { .. })), "{huge:?}");
+    let huge = ClothBuilder::new(Vec3::ZERO, 1 << 13, 1 << 12, 0.1).build();
+    assert!(matches!(huge, Err(Error::OutOfRange { .. })));
+    let mut w = world(1, G);
+    let rope = hooke::ChainBuilder::rope(Vec3::ZERO, Vec3::X, usize::MAX).spawn(&mut w);
+    assert!(matches!(rope, Err(Error::OutOfRange { .. })), "{rope:?}");
+}
+
+#[test]
 fn zero_length_and_coincident_springs_give_no_nan() {
     for implicit in [false, true] {
         let mut w = world(4, G);

@@ -403,6 +403,7 @@ fn main() {
     }
     if run("springs") {
         springs::implicit_springs(&cfg);
+        springs::cloth_vs_rapier(&cfg, if quick { 120 } else { 600 });
     }
     if run("soft") {
         soft::soft_lines(&cfg);

@@ -76,3 +76,112 @@ pub fn implicit_springs(cfg: &Config) {
         },
     );
 }
+
+/// Rapier 0.36's cloth (`SoftBodyBuilder::cloth`, constraint solver, its defaults: 60 Hz, 4
+/// substeps) and hooke's on the same grid: 30 × 30 particles 0.1 m apart, 0.02 kg each,
+/// hung by two corners. Each one's largest stretch of a grid edge after `steps` steps is
+/// printed beside the time ratio.
+pub fn cloth_vs_rapier(cfg: &Config, steps: usize) {
+    use rapier3d::prelude as rp;
+    let (n, s, m) = (30usize, 0.1f32, 0.02f32);
+    let mut r = rp::PhysicsWorld::new();
+    let builder = rp::SoftBodyBuilder::cloth(
+        rp::Vector::new(0.0, 3.0, 0.0),
+        rp::Vector::new(s, 0.0, 0.0),
+        rp::Vector::new(0.0, 0.0, s),
+        n,
+        n,
+    )
+    .pinned_particles([0, (n - 1) as u32])
+    .softness(rp::SpringCoefficients::new(100.0, 1.0))
+    .can_sleep(false)
+    .particle_mass(m);
+    let handle = r.insert_soft_body(builder);
+    for _ in 0..steps {
+        r.step();
+    }
+    let theirs = {
+        let sb = &r.soft_bodies[handle];
+        sb.edges()
+            .iter()
+            .filter(|e| (e.rest_length - s).abs() < 1e-4)
+            .map(|e| {
+                let [a, b] = e.vertices.map(|i| sb.particle_position(i as usize));
+                (b - a).length() / e.rest_length - 1.0
+            })
+            .fold(0.0f32, f32::max)
+    };
+    // hooke on the same grid: explicit at the substeps its springs need (None), with and
+    // without strain limiting, and implicit at one substep.
+    for (name, substeps, k, limit) in [
+        (
+            "springs_cloth30_symplectic_k400_vs_rapier",
+            None,
+            400.0f32,
+            None,
+        ),
+        (
+            "springs_cloth30_symplectic_k400_limit10_vs_rapier",
+            None,
+            400.0,
+            Some(0.1),
+        ),
+        (
+            "springs_cloth30_symplectic_k3000_vs_rapier",
+            None,
+            3000.0,
+            None,
+        ),
+        (
+            "springs_cloth30_symplectic_k6000_vs_rapier",
+            None,
+            6000.0,
+            None,
+        ),
+        (
+            "springs_cloth30_implicit_x1_k3000_vs_rapier",
+            Some(1u32),
+            3000.0,
+            None,
+        ),
+    ] {
+        let (nodes, net, cloth) = ClothBuilder::new(Vec3::new(0.0, 3.0, 0.0), n, n, s)
+            .node_mass(m)
+            .stiffness(k, k / 4.0, k / 40.0)
+            .damping(0.05)
+            .build_cloth()
+            .unwrap();
+        let implicit = substeps.is_some();
+        let substeps = substeps
+            .unwrap_or_else(|| ((1.0 / 60.0) / (0.9 * net.critical_step(&nodes))).ceil() as u32);
+        let mut w = world(substeps);
+        let cloth = cloth.with_strain_limit(limit).unwrap();
+        let e = w.spawn((nodes, net, cloth)).id();
+        if implicit {
+            w.entity_mut(e).insert(ImplicitEuler::default());
+        }
+        for _ in 0..steps {
+            w.step_physics();
+        }
+        let ours = {
+            let (nodes, net, cloth) = (
+                w.get::<Nodes>(e).unwrap(),
+                w.get::<SpringNetwork>(e).unwrap(),
+                w.get::<hooke::Cloth>(e).unwrap(),
+            );
+            cloth.max_strain(nodes, net)
+        };
+        let (t_ours, t_theirs) = compare(cfg, || w.step_physics(), || r.step());
+        line(
+            name,
+            t_ours,
+            t_theirs,
+            &format!(
+                "largest grid-edge stretch after {:.0} s: hooke {:.2} % (k = {k} N/m, x{substeps}), rapier {:.2} % (x4)",
+                steps as f32 / 60.0,
+                100.0 * ours,
+                100.0 * theirs
+            ),
+        );
+    }
+}

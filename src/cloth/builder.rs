@@ -54,6 +54,20 @@ impl ClothBuilder {
         self
     }
 
+    /// Mass of each node (kg).
+    #[must_use]
+    pub fn node_mass(mut self, kg: f32) -> Self {
+        self.node_mass = kg;
+        self
+    }
+
+    /// Damping c (N·s/m) of every spring.
+    #[must_use]
+    pub fn damping(mut self, c: f32) -> Self {
+        self.damping = c;
+        self
+    }
+
     /// Whether the first row's two corners are pinned.
     #[must_use]
     pub fn pin_corners(mut self, pin: bool) -> Self {
@@ -77,6 +91,17 @@ impl ClothBuilder {
         }
         let s = positive("cloth spacing", self.spacing)?;
         let (nx, nz) = (self.nx, self.nz);
+        // Refused before anything is allocated (the product may not even fit a usize).
+        if nx
+            .checked_mul(nz)
+            .is_none_or(|n| n > crate::springs::MAX_BUILDER_NODES)
+        {
+            return Err(Error::OutOfRange {
+                what: "cloth node count",
+                value: nx as f32 * nz as f32,
+                range: "at most 2^24",
+            });
+        }
         let mut nodes = Nodes::with_capacity(nx * nz);
         for j in 0..nz {
             for i in 0..nx {

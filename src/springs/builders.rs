@@ -7,6 +7,10 @@ use super::Spring;
 use crate::error::{Error, Result, finite_vec, non_negative, positive};
 use crate::particles::ParticleBundle;
 
+/// The most nodes a builder makes (2²⁴): far past any rope or cloth a game steps, and small
+/// enough that a typo like `usize::MAX` is an error rather than an allocation failure.
+pub(crate) const MAX_BUILDER_NODES: usize = 1 << 24;
+
 /// A chain of particle entities joined by springs: a rope, or with bending springs (node i to
 /// node i + 2) a hair strand.
 #[derive(Debug, Clone, PartialEq)]
@@ -159,6 +163,13 @@ impl ChainBuilder {
                 what: "chain nodes",
                 min: 2,
                 got: self.nodes,
+            });
+        }
+        if self.nodes > MAX_BUILDER_NODES {
+            return Err(Error::OutOfRange {
+                what: "chain node count",
+                value: self.nodes as f32,
+                range: "at most 2^24",
             });
         }
         let start = finite_vec("chain start", self.start)?;

@@ -36,6 +36,7 @@ mod implicit;
 mod plugin;
 pub mod stability;
 
+pub(crate) use builders::MAX_BUILDER_NODES;
 pub use builders::{Chain, ChainBuilder};
 pub use plugin::SpringPlugin;
 pub(crate) use plugin::{Endpoint, Spinning, anchor_state};
