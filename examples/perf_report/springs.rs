@@ -44,7 +44,7 @@ fn pair(cfg: &Config, name: &str, mesh: impl Fn() -> (Nodes, SpringNetwork)) {
 }
 
 pub fn implicit_springs(cfg: &Config) {
-    for n in [32usize, 64] {
+    for n in [32usize, 64, 128] {
         pair(
             cfg,
             &format!("springs_cloth{n}_implicit_x1_vs_symplectic_needed"),

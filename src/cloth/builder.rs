@@ -21,7 +21,7 @@ pub struct ClothBuilder {
     k_structural: f32,
     k_shear: f32,
     k_bend: f32,
-    damping: f32,
+    damping: [f32; 3],
     pin_corners: bool,
 }
 
@@ -42,7 +42,7 @@ impl ClothBuilder {
             k_structural: 8.0,
             k_shear: 4.0,
             k_bend: 1.0,
-            damping: 0.01,
+            damping: [0.01; 3],
             pin_corners: true,
         }
     }
@@ -64,7 +64,14 @@ impl ClothBuilder {
     /// Damping c (N·s/m) of every spring.
     #[must_use]
     pub fn damping(mut self, c: f32) -> Self {
-        self.damping = c;
+        self.damping = [c; 3];
+        self
+    }
+
+    /// Damping (N·s/m) of the structural, shear and bending springs.
+    #[must_use]
+    pub fn family_damping(mut self, structural: f32, shear: f32, bend: f32) -> Self {
+        self.damping = [structural, shear, bend];
         self
     }
 
@@ -115,7 +122,7 @@ impl ClothBuilder {
         }
         let id = |i: usize, j: usize| j * nx + i;
         let mut net = SpringNetwork::new();
-        let c = self.damping;
+        let [c, c_shear, c_bend] = self.damping;
         let diag = s * std::f32::consts::SQRT_2;
         for j in 0..nz {
             for i in 0..nx {
@@ -126,14 +133,14 @@ impl ClothBuilder {
                     net.push(id(i, j), id(i, j + 1), s, self.k_structural, c)?;
                 }
                 if i + 1 < nx && j + 1 < nz {
-                    net.push(id(i, j), id(i + 1, j + 1), diag, self.k_shear, c)?;
-                    net.push(id(i + 1, j), id(i, j + 1), diag, self.k_shear, c)?;
+                    net.push(id(i, j), id(i + 1, j + 1), diag, self.k_shear, c_shear)?;
+                    net.push(id(i + 1, j), id(i, j + 1), diag, self.k_shear, c_shear)?;
                 }
                 if i + 2 < nx {
-                    net.push(id(i, j), id(i + 2, j), 2.0 * s, self.k_bend, c)?;
+                    net.push(id(i, j), id(i + 2, j), 2.0 * s, self.k_bend, c_bend)?;
                 }
                 if j + 2 < nz {
-                    net.push(id(i, j), id(i, j + 2), 2.0 * s, self.k_bend, c)?;
+                    net.push(id(i, j), id(i, j + 2), 2.0 * s, self.k_bend, c_bend)?;
                 }
             }
         }

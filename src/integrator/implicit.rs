@@ -74,6 +74,12 @@ pub(crate) trait ImplicitElements {
     fn apply(&self, k: usize, h: &Self::Hess, dx: &[DVec3], scale: f64, out: &mut [DVec3]);
     /// out += scale · diag(K_k).
     fn add_diagonal(&self, k: usize, h: &Self::Hess, scale: f64, out: &mut [DVec3]);
+    /// Whether element k goes into the preconditioner's factor (all by default). Leaving
+    /// out weak elements that couple far nodes (a cloth's bending springs) narrows the
+    /// factor's envelope; the conjugate gradients still solve with every element.
+    fn in_factor(&self, _k: usize) -> bool {
+        true
+    }
     /// Calls `add(i, j, block)` for element k's node blocks of scale · K_k.
     fn blocks(&self, k: usize, h: &Self::Hess, scale: f64, add: &mut dyn FnMut(u32, u32, DMat3));
     /// Called at the end of a solve with the end state's elements and energy.
@@ -189,7 +195,7 @@ fn prepare_factor<E: ImplicitElements>(
         state.factor = None;
         if settings.max_factor_entries > 0 {
             let mut adjacency = vec![Vec::new(); len];
-            for k in 0..body.count() {
+            for k in (0..body.count()).filter(|&k| body.in_factor(k)) {
                 let t = body.nodes(k);
                 for &a in t {
                     adjacency[a as usize].extend_from_slice(t);
@@ -226,6 +232,7 @@ fn refresh_factor<'a, E: ImplicitElements>(
     let factor = state.factor.as_mut()?;
     if renew {
         state.refactor = false;
+        state.excess = 0.0;
         let mass_term = |m: f32| f64::from(m) * (1.0 / (hd * hd) + alpha / hd);
         factor.factor(|add| {
             for i in 0..free.len() {
@@ -240,7 +247,7 @@ fn refresh_factor<'a, E: ImplicitElements>(
                     add(i, j, b);
                 }
             };
-            for k in 0..body.count() {
+            for k in (0..body.count()).filter(|&k| body.in_factor(k)) {
                 body.blocks(k, &hess[k], 1.0, &mut free_only);
                 if let Some(d) = s.hess0.get(k) {
                     body.blocks(k, d, 1.0 / hd, &mut free_only);
@@ -488,8 +495,16 @@ pub(crate) fn step<E: ImplicitElements>(
             // With a lagged factor, CG on an indefinite H need not meet its negative
             // curvature and can return a direction that climbs E: that is a failure too.
             let ok = ok && dot(&s.g, &s.dx) < 0.0;
-            if factor.is_some() && report.cg_iterations - before > settings.refactor_after {
-                state.refactor = true;
+            // The lagged factor is kept while the iterations it costs past `refactor_after`
+            // add up to less than a new factorisation would.
+            let extra = (report.cg_iterations - before).saturating_sub(settings.refactor_after);
+            if extra > 0
+                && let Some(f) = state.factor.as_ref()
+            {
+                state.excess += f64::from(extra);
+                if state.excess >= f.solves_per_factor() {
+                    state.refactor = true;
+                }
             }
             if projected {
                 s.hess = hess;

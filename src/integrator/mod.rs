@@ -174,10 +174,11 @@ pub struct ImplicitEuler {
     /// this many numbers (8 bytes each; default 2,000,000, 16 MB); a larger body falls back
     /// to the diagonal (Jacobi). 0 turns the factor off.
     pub max_factor_entries: usize,
-    /// The factor is kept from step to step and renewed when a solve needed more than this
-    /// many conjugate-gradient iterations (default 4): a factor of a nearby matrix is still
-    /// an exact-enough preconditioner, and renewing it costs about a bandwidth² times the
-    /// unknowns.
+    /// The factor is kept from step to step: a factor of a nearby matrix is still an
+    /// exact-enough preconditioner, and renewing it costs about a bandwidth² times the
+    /// unknowns. Conjugate-gradient iterations past this many per solve (default 1: a fresh
+    /// factor solves in one) are counted against it, and it is renewed once they add up to
+    /// the cost of a new one (each iteration is a pair of triangular solves).
     pub refactor_after: u32,
 }
 
@@ -191,6 +192,8 @@ pub struct ImplicitState {
     /// The substep the factor was made at, and whether the last solve asked for a new one.
     pub(crate) h: f32,
     pub(crate) refactor: bool,
+    /// Conjugate-gradient iterations past `refactor_after` since the factor was made.
+    pub(crate) excess: f64,
     /// The last substep's solve.
     pub(crate) last: ImplicitReport,
 }
@@ -210,7 +213,7 @@ impl Default for ImplicitEuler {
             max_newton: 8,
             max_cg: 200,
             max_factor_entries: 2_000_000,
-            refactor_after: 4,
+            refactor_after: 1,
         }
     }
 }

@@ -101,6 +101,9 @@ pub(crate) struct SkylineCholesky {
     factored: bool,
     /// Counts the factorisations, so that what was derived from a factor can tell it is stale.
     generation: u64,
+    /// Multiply-adds of one factorisation (Σ row length² / 2) and of one solve (2 × entries).
+    factor_cost: f64,
+    solve_cost: f64,
 }
 
 impl SkylineCholesky {
@@ -134,6 +137,9 @@ impl SkylineCholesky {
             return None;
         }
         let entries = start[rows];
+        let factor_cost = (0..rows)
+            .map(|r| ((r - first[r] as usize + 1) as f64).powi(2) / 2.0)
+            .sum();
         Some(Self {
             order,
             rank,
@@ -142,7 +148,15 @@ impl SkylineCholesky {
             values: vec![0.0; entries],
             factored: false,
             generation: 0,
+            factor_cost,
+            solve_cost: 2.0 * entries as f64,
         })
+    }
+
+    /// How many solves cost as much as one factorisation.
+    #[must_use]
+    pub(crate) fn solves_per_factor(&self) -> f64 {
+        self.factor_cost / self.solve_cost.max(1.0)
     }
 
     /// Whether a factor is held (the last [`Self::factor`] succeeded).

@@ -113,6 +113,7 @@ impl EntitySolve {
         s.k.clear();
         s.c.clear();
         s.max_index = 0;
+        s.max_k = 0.0;
         self.ends.clear();
         self.index.clear();
         self.anchors_per_body.clear();

@@ -280,6 +280,9 @@ pub struct SpringNetwork {
     pub(crate) c: Vec<f32>,
     /// Largest node index used, so one comparison per step proves every index in range.
     pub(crate) max_index: u32,
+    /// The largest stiffness (N/m): springs under a tenth of it stay out of the implicit
+    /// solve's factor (see `ImplicitElements::in_factor`).
+    pub(crate) max_k: f32,
 }
 
 impl SpringNetwork {
@@ -322,6 +325,7 @@ impl SpringNetwork {
         self.k.push(k);
         self.c.push(c);
         self.max_index = self.max_index.max(ia).max(ib);
+        self.max_k = self.max_k.max(k);
         Ok(self.ends.len() - 1)
     }
 

@@ -111,6 +111,7 @@ fn apply_spring_forces(
     mut forces: Query<&mut Force, Live>,
     mut torques: Query<&mut Torque, Live>,
     masses: Query<&crate::particles::Mass>,
+    positions: Query<&Position>,
 ) {
     let global = *global;
     for (spring, s, flagged) in &springs {
@@ -125,6 +126,15 @@ fn apply_spring_forces(
         }
         // A quarantined or missing endpoint drops out of the query, so NaN can't cross.
         let (Ok(ea), Ok(eb)) = (states.get(s.a), states.get(s.b)) else {
+            orphaned(
+                &mut commands,
+                &guard,
+                spring,
+                s,
+                &states,
+                &positions,
+                &masses,
+            );
             continue;
         };
         // Rotation is looked up only for an anchored end: plain ropes pay for two lookups.
@@ -180,6 +190,39 @@ fn apply_spring_forces(
             && let Ok(mut t) = torques.get_mut(s.b)
         {
             t.bypass_change_detection().0 -= rb.cross(f);
+        }
+    }
+}
+
+/// A spring whose one end was quarantined acts no more; if it was torn past the guard's
+/// strain, its live free end took part in the divergence (it was flung by that spring) and
+/// leaves too, named by it, instead of flying on ballistic.
+fn orphaned(
+    commands: &mut Commands,
+    guard: &crate::quarantine::DivergenceGuard,
+    spring: Entity,
+    s: &Spring,
+    states: &Query<Endpoint, Live>,
+    positions: &Query<&Position>,
+    masses: &Query<&crate::particles::Mass>,
+) {
+    let (Ok(pa), Ok(pb)) = (positions.get(s.a), positions.get(s.b)) else {
+        return;
+    };
+    if s.rest_length == 0.0 {
+        return;
+    }
+    let strain = ((pb.0 - pa.0).length() - s.rest_length) / s.rest_length;
+    // A quarantined end that went non-finite (NaN written by game code) says nothing about
+    // its neighbours: only a finite, torn spring does.
+    if !strain.is_finite() || strain.abs() <= guard.max_spring_strain {
+        return;
+    }
+    for end in [s.a, s.b] {
+        if states.contains(end) && masses.get(end).is_ok_and(|m| !m.is_pinned()) {
+            commands.entity(end).insert(Quarantined {
+                reason: QuarantineReason::SpringFailed { spring, strain },
+            });
         }
     }
 }
