@@ -109,22 +109,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let red = RGBColor(200, 60, 40);
 
         // The flag from above: x along the flag, z downwind.
-        let mut chart = ChartBuilder::on(&left)
-            .caption(
-                title("flag in an 8 m/s wind (top view)"),
-                ("sans-serif", 16),
-            )
-            .margin(10)
-            .x_label_area_size(34)
-            .y_label_area_size(44)
-            .build_cartesian_2d(-0.2f32..1.2f32, -0.3f32..1.1f32)?;
-        chart
-            .configure_mesh()
-            .x_desc("x (m)")
-            .y_desc("z, downwind (m)")
-            .label_style(("sans-serif", 12))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        let mut chart = panel(
+            &left,
+            title("flag in an 8 m/s wind (top view)"),
+            (-0.2..1.2, -0.3..1.1),
+            ("x (m)", "z, downwind (m)"),
+        )?;
         draw_cloth(&mut chart, &windy, flag, blue, "flag edges", |p| (p.x, p.z))?;
         chart
             .draw_series([Circle::new((0.0f32, 0.0f32), 5, BLACK.filled())])?
@@ -142,22 +132,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         legend(&mut chart)?;
 
         // The drape from the side.
-        let mut chart = ChartBuilder::on(&right)
-            .caption(
-                title("draped over a sphere (side view)"),
-                ("sans-serif", 16),
-            )
-            .margin(10)
-            .x_label_area_size(34)
-            .y_label_area_size(44)
-            .build_cartesian_2d(-0.9f32..0.9f32, -0.05f32..1.25f32)?;
-        chart
-            .configure_mesh()
-            .x_desc("x (m)")
-            .y_desc("height y (m)")
-            .label_style(("sans-serif", 12))
-            .light_line_style(RGBColor(235, 235, 235))
-            .draw()?;
+        let mut chart = panel(
+            &right,
+            title("draped over a sphere (side view)"),
+            (-0.9..0.9, -0.05..1.25),
+            ("x (m)", "height y (m)"),
+        )?;
         let circle = (0..=64).map(|k| {
             let a = k as f32 / 64.0 * std::f32::consts::TAU;
             (radius * a.cos(), radius + radius * a.sin())
@@ -181,6 +161,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         per(1)
     );
     Ok(())
+}
+
+/// A titled panel with labelled axes over `range` (m).
+fn panel<'a, 'b: 'a>(
+    area: &'a DrawingArea<BitMapBackend<'b>, plotters::coord::Shift>,
+    title: String,
+    range: (std::ops::Range<f32>, std::ops::Range<f32>),
+    axes: (&str, &str),
+) -> Result<Chart<'a, 'b>, Box<dyn std::error::Error>> {
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, ("sans-serif", 16))
+        .margin(10)
+        .x_label_area_size(34)
+        .y_label_area_size(44)
+        .build_cartesian_2d(range.0, range.1)?;
+    chart
+        .configure_mesh()
+        .x_desc(axes.0)
+        .y_desc(axes.1)
+        .label_style(("sans-serif", 12))
+        .light_line_style(RGBColor(235, 235, 235))
+        .draw()?;
+    Ok(chart)
 }
 
 type Chart<'a, 'b> = ChartContext<

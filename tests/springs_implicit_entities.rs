@@ -302,6 +302,41 @@ fn leaving_the_implicit_dial_takes_the_dials_solver_off_the_meshes() {
     let _ = w.resource::<PhysicsTime>();
 }
 
+/// 10 links of 1 kg holding 10,000 kg, k = 1e6 N/m and c = 2e5 N·s/m per link, hung
+/// straight down from (0, 5, 0).
+fn loaded_chain(w: &mut World) -> hooke::Chain {
+    ChainBuilder::rope(Vec3::new(0.0, 5.0, 0.0), Vec3::new(0.0, 4.0, 0.0), 11)
+        .node_mass(1.0)
+        .stiffness(1e6)
+        .damping(2e5)
+        .end_load(1e4)
+        .spawn(w)
+        .unwrap()
+}
+
+/// 30 nodes of 1 g over 1 m between two pins, pre-stretched 5 %, k = 1e5 N/m.
+fn taut_string(w: &mut World) -> hooke::Chain {
+    ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0), 30)
+        .node_mass(0.001)
+        .stiffness(1e5)
+        .damping(0.05)
+        .pin_end(true)
+        .rest_scale(0.95)
+        .spawn(w)
+        .unwrap()
+}
+
+/// 1 g beads on springs of 1e6 N/m (ω = 3e4 rad/s, 130 times the substep's limit): a 0.5 m
+/// rope from a pin at (0, 1, 0), released horizontal.
+fn stiff_beads(w: &mut World) -> hooke::Chain {
+    ChainBuilder::rope(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.5, 1.0, 0.0), 6)
+        .node_mass(0.001)
+        .stiffness(1e6)
+        .damping(0.1)
+        .spawn(w)
+        .unwrap()
+}
+
 /// The hard-case catalogue at the defaults (60 Hz, 4 substeps, the default policy): each
 /// stays finite and bounded, never quarantined, and comes to rest.
 fn settles(name: &str, w: &mut World, nodes: &[Entity], seconds: f32, bound: f32) {
@@ -334,13 +369,7 @@ fn a_light_chain_holding_a_thousand_times_its_link_mass_settles() {
     // damped in about a second; it is the springs' 1e4 rad/s modes that need the implicit
     // solve).
     let mut w = default_world();
-    let chain = ChainBuilder::rope(Vec3::new(0.0, 5.0, 0.0), Vec3::new(0.0, 4.0, 0.0), 11)
-        .node_mass(1.0)
-        .stiffness(1e6)
-        .damping(2e5)
-        .end_load(1e4)
-        .spawn(&mut w)
-        .unwrap();
+    let chain = loaded_chain(&mut w);
     settles("1:1000 chain", &mut w, &chain.nodes, 10.0, 6.0);
     let top = w
         .get::<Spring>(chain.springs[0])
@@ -359,66 +388,47 @@ fn a_light_chain_holding_a_thousand_times_its_link_mass_settles() {
 fn a_taut_string_of_light_masses_pinned_at_both_ends_settles() {
     // 30 nodes of 1 g over 1 m, pre-stretched 5 % between two pins, k = 1e5 N/m.
     let mut w = default_world();
-    let string = ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0), 30)
-        .node_mass(0.001)
-        .stiffness(1e5)
-        .damping(0.05)
-        .pin_end(true)
-        .rest_scale(0.95)
-        .spawn(&mut w)
-        .unwrap();
+    let string = taut_string(&mut w);
     settles("taut string", &mut w, &string.nodes, 5.0, 3.0);
     let mid = common::x(&w, string.nodes[15]);
     assert!((mid.y - 2.0).abs() < 1e-3, "barely sags: {mid}");
 }
 
+/// The farthest any of `nodes` gets from the origin over `steps` steps, asserting that
+/// nothing is quarantined.
+fn bounded(name: &str, w: &mut World, nodes: &[Entity], steps: usize) -> f32 {
+    let mut farthest = 0.0f32;
+    for _ in 0..steps {
+        w.step_physics();
+        for &n in nodes {
+            farthest = farthest.max(common::x(w, n).length());
+        }
+    }
+    let quarantined = w.resource::<PhysicsDiagnostics>().quarantined_total;
+    println!("{name}: farthest node {farthest:.3} m, quarantined {quarantined}");
+    assert_eq!(quarantined, 0, "{name}");
+    farthest
+}
+
 #[test]
-fn a_rope_whose_end_is_yanked_at_50_m_s_stays_finite_and_settles() {
+fn a_rope_whose_end_is_yanked_at_50_m_s_stays_finite_and_bounded() {
     let mut w = default_world();
     let rope = stiff_rope().spawn(&mut w).unwrap();
     let end = *rope.nodes.last().unwrap();
     w.step_physics();
     w.get_mut::<LinearVelocity>(end).unwrap().0 = glam::Vec3A::new(0.0, 50.0, 50.0);
-    let mut farthest = 0.0f32;
-    for _ in 0..600 {
-        w.step_physics();
-        for &n in &rope.nodes {
-            farthest = farthest.max(common::x(&w, n).length());
-        }
-    }
-    let d = w.resource::<PhysicsDiagnostics>();
-    println!(
-        "yanked rope: farthest node {farthest:.3} m, quarantined {}",
-        d.quarantined_total
-    );
-    assert_eq!(d.quarantined_total, 0);
+    let farthest = bounded("yanked rope", &mut w, &rope.nodes, 600);
     // The rope is 1 m long from a pin at (0, 2, 0): no node gets past 3.1 m from the origin.
     assert!(farthest < 3.1, "{farthest}");
 }
 
 #[test]
-fn very_stiff_springs_on_light_masses_settle() {
-    // 1 g beads on springs of 1e6 N/m (ω = 3e4 rad/s, 130 times the substep's limit).
+fn very_stiff_springs_on_light_masses_stay_finite_and_bounded() {
+    // 1 g beads on springs of 1e6 N/m (ω = 3e4 rad/s, 130 times the substep's limit), swinging
+    // down from the horizontal: a 0.5 m rope from a pin at (0, 1, 0).
     let mut w = default_world();
-    let beads = ChainBuilder::rope(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.5, 1.0, 0.0), 6)
-        .node_mass(0.001)
-        .stiffness(1e6)
-        .damping(0.1)
-        .spawn(&mut w)
-        .unwrap();
-    let mut farthest = 0.0f32;
-    for _ in 0..600 {
-        w.step_physics();
-        for &n in &beads.nodes {
-            farthest = farthest.max(common::x(&w, n).length());
-        }
-    }
-    let d = w.resource::<PhysicsDiagnostics>();
-    println!(
-        "stiff beads: farthest {farthest:.3} m, quarantined {}",
-        d.quarantined_total
-    );
-    assert_eq!(d.quarantined_total, 0);
+    let beads = stiff_beads(&mut w);
+    let farthest = bounded("stiff beads", &mut w, &beads.nodes, 600);
     assert!(farthest < 1.6, "{farthest}");
 }
 
@@ -430,36 +440,9 @@ fn under_explicit_integration_each_hard_case_is_caught_in_the_step_it_diverges()
     type Build = fn(&mut World) -> Vec<Entity>;
     let cases: [(&str, Build); 4] = [
         ("stiff rope", |w| stiff_rope().spawn(w).unwrap().nodes),
-        ("1:1000 chain", |w| {
-            ChainBuilder::rope(Vec3::new(0.0, 5.0, 0.0), Vec3::new(0.0, 4.0, 0.0), 11)
-                .node_mass(1.0)
-                .stiffness(1e6)
-                .damping(2e5)
-                .end_load(1e4)
-                .spawn(w)
-                .unwrap()
-                .nodes
-        }),
-        ("taut string", |w| {
-            ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0), 30)
-                .node_mass(0.001)
-                .stiffness(1e5)
-                .damping(0.05)
-                .pin_end(true)
-                .rest_scale(0.95)
-                .spawn(w)
-                .unwrap()
-                .nodes
-        }),
-        ("stiff beads", |w| {
-            ChainBuilder::rope(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.5, 1.0, 0.0), 6)
-                .node_mass(0.001)
-                .stiffness(1e6)
-                .damping(0.1)
-                .spawn(w)
-                .unwrap()
-                .nodes
-        }),
+        ("1:1000 chain", |w| loaded_chain(w).nodes),
+        ("taut string", |w| taut_string(w).nodes),
+        ("stiff beads", |w| stiff_beads(w).nodes),
     ];
     for (name, build) in cases {
         let mut w = default_world();
