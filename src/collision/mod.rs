@@ -21,7 +21,13 @@
 //! [`crate::StepSystems::RelaxConstraints`] solves once more without bias so that the
 //! push-out does not stay in the velocities. After the last substep, restitution brings the
 //! normal velocity of every contact that hit faster than [`ContactSettings::restitution_threshold`]
-//! to −e times its approach speed. Friction is Coulomb's, one 2D constraint per manifold at
+//! to −e times its approach speed (Newton's law), but never past the impulse that ends its
+//! compression plus e times the compression impulse (Poisson's law), and never giving back
+//! more than e² of the kinetic energy the step's normal impulses took out: contacts never
+//! create energy. An isolated impact bounces exactly; a row of touching bodies struck at one
+//! end spreads the velocity over the row, as sequential impulses do, instead of passing it
+//! all to the far end as a Newton's cradle would (two balls exchange their velocities
+//! exactly; three keep 77 % of the energy, five 56 %). Friction is Coulomb's, one 2D constraint per manifold at
 //! its centre clamped to μ times the manifold's normal impulse, plus a twist friction about
 //! the normal, solved in the relax pass. Each manifold keeps at most four points, and the
 //! solver takes four manifolds at a time in SIMD lanes (see the `solver` module). A
@@ -313,6 +319,21 @@ impl Validate for Restitution {
     }
 }
 
+/// A collider's own restitution threshold (m/s, ≥ 0): its contacts bounce when they hit
+/// faster than this, instead of [`ContactSettings::restitution_threshold`]. Of two colliders
+/// with one each, the contact takes the lower. A small threshold lets slow impacts bounce
+/// too (a ball's bounce series goes on longer); too small, and a resting body jitters on the
+/// bounces of its own settling.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[component(on_insert = validate_on_insert::<Self>)]
+pub struct RestitutionThreshold(pub f32);
+
+impl Validate for RestitutionThreshold {
+    fn validate(&self) -> Result<()> {
+        non_negative("restitution threshold", self.0).map(|_| ())
+    }
+}
+
 /// How two colliders' coefficients combine into one for their contact.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum CombineRule {
@@ -398,7 +419,8 @@ pub struct ContactSettings {
     pub damping_ratio: f32,
     /// Fastest push-out speed for resolving penetration (m/s).
     pub max_push_velocity: f32,
-    /// Approach speed below which restitution is ignored (m/s).
+    /// Approach speed below which restitution is ignored (m/s; default 1, as rapier and
+    /// avian). A collider's [`RestitutionThreshold`] overrides it for its contacts.
     pub restitution_threshold: f32,
     /// Extra margin around bounding boxes and in contact prediction (m).
     pub margin: f32,

@@ -12,7 +12,7 @@ use super::narrow::{ContactImpulse, Contacts, PairState, Recycle, choose_points}
 use super::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody};
 use super::{
     Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted,
-    Friction, Restitution, Sensor,
+    Friction, Restitution, RestitutionThreshold, Sensor,
 };
 use crate::WorldPlugin;
 use crate::integrator::ConstraintsActive;
@@ -462,6 +462,7 @@ type PreparedBody<'a> = (
     Option<&'a AngularVelocity>,
     &'a Friction,
     &'a Restitution,
+    Option<&'a RestitutionThreshold>,
     Has<Sleeping>,
 );
 
@@ -479,6 +480,8 @@ struct Side {
     w: Vec3A,
     friction: f32,
     restitution: f32,
+    /// The collider's own restitution threshold (m/s), if it has one.
+    threshold: Option<f32>,
     /// What a solver body is made of: mass (none for static colliders), whether the body
     /// moves (has a velocity and is awake), and inertia.
     mass: Option<Mass>,
@@ -490,7 +493,8 @@ impl Side {
     const UNSET: u32 = u32::MAX - 1;
 
     fn new(body: bevy_ecs::query::ROQueryItem<'_, '_, PreparedBody>) -> Self {
-        let (entity, x, q, com, mass, v, inertia, w, friction, restitution, sleeping) = body;
+        let (entity, x, q, com, mass, v, inertia, w, friction, restitution, threshold, sleeping) =
+            body;
         Side {
             entity,
             index: Side::UNSET,
@@ -501,6 +505,7 @@ impl Side {
             w: w.map_or(Vec3A::ZERO, |w| w.0),
             friction: friction.0,
             restitution: restitution.0,
+            threshold: threshold.map(|t| t.0),
             mass: mass.copied(),
             moves: v.is_some() && !sleeping,
             inertia: inertia.copied(),
@@ -637,6 +642,12 @@ fn prepare_contacts(
         let restitution = settings
             .restitution_rule
             .combine(a.restitution, b.restitution);
+        // The lower of the two colliders' own thresholds, else the world's.
+        let threshold = match (a.threshold, b.threshold) {
+            (Some(x), Some(y)) => x.min(y),
+            (Some(x), None) | (None, Some(x)) => x,
+            (None, None) => settings.restitution_threshold,
+        };
         for (mi, m) in state.manifolds.iter().enumerate() {
             if m.points.is_empty() {
                 continue;
@@ -683,6 +694,7 @@ fn prepare_contacts(
                 t,
                 friction,
                 restitution,
+                threshold,
                 first,
                 count: s.inputs.len() as u32 - first,
                 pair: (ea, eb),
@@ -736,7 +748,7 @@ fn relax_contacts(
     let (soft, fixed) = softness(&settings, time.h);
     solver.solve(time.h, soft, fixed, false, settings.max_push_velocity);
     if time.is_last() {
-        solver.restitution(settings.restitution_threshold);
+        solver.restitution();
         for solved in solver.manifold_impulses() {
             let m = solved.constraint;
             let Some(tracked) = contacts

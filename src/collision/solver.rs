@@ -107,6 +107,8 @@ pub(crate) struct ManifoldConstraint {
     pub t: [Vec3A; 2],
     pub friction: f32,
     pub restitution: f32,
+    /// Approach speed below which this manifold does not bounce (m/s).
+    pub threshold: f32,
     pub first: u32,
     pub count: u32,
     pub pair: (Entity, Entity),
@@ -180,6 +182,27 @@ struct Point {
     /// Normal velocity seen by the last two biased passes (one substep apart): their
     /// difference is the approach acceleration, used to extrapolate the speed of impact.
     vn_seen: [F4; 2],
+    /// The normal impulse the point gave over this step's substeps (each substep's total,
+    /// warm start included): the compression impulse that bounds its restitution.
+    absorbed: F4,
+    /// Kinetic energy its normal impulses took out of the two bodies this step (J; negative
+    /// for energy they put in): what its restitution may give back.
+    lost: F4,
+    /// Half the inverse of the normal's effective mass (zero on padding lanes).
+    half_w: F4,
+    /// The relative normal velocity the last pass left (for the next warm start's work).
+    vn_end: F4,
+    /// The relative normal velocity when the point first pushed this step; `approach`
+    /// extrapolates the impact speed past it.
+    vn_first: F4,
+}
+
+/// The kinetic energy an impulse λ along a point's normal adds to its two bodies, with vn
+/// their relative normal velocity before it: λ (vn + λ / 2m), m the point's effective mass
+/// (`half_w` = 1 / 2m).
+#[inline]
+fn work(lambda: F4, vn: F4, half_w: F4) -> F4 {
+    lambda * (vn + lambda * half_w)
 }
 
 /// Up to four manifolds with no dynamic body in common, solved together.
@@ -199,6 +222,9 @@ struct Batch {
     inv_m_b: F4,
     friction: F4,
     restitution: F4,
+    /// Minus the restitution threshold (m/s): an approach (negative) below it, faster than
+    /// the threshold, bounces.
+    threshold: F4,
     /// All-ones in lanes where one side is static: they use the stiffer static softness.
     fixed: F4,
 }
@@ -459,6 +485,7 @@ impl ContactSolver {
             inv_m_b: F4::ZERO,
             friction: scalar(|m| m.friction),
             restitution: scalar(|m| m.restitution),
+            threshold: scalar(|m| -m.threshold),
             fixed: F4::new(fixed.map(|f| if f { f32::from_bits(!0) } else { 0.0 })),
         };
         for k in 0..count {
@@ -484,6 +511,11 @@ impl ContactSolver {
                 max_n: F4::ZERO,
                 approach: F4::new(s[2]),
                 vn_seen: [F4::splat(f32::NAN); 2],
+                absorbed: F4::ZERO,
+                lost: F4::ZERO,
+                half_w: F4::ZERO,
+                vn_end: F4::ZERO,
+                vn_first: F4::ZERO,
             });
         }
         self.friction
@@ -519,6 +551,11 @@ impl ContactSolver {
                 }
             }));
             p.normal = Axis::new(ma, &ia, p.r_a, mb, &ib, p.r_b, batch.n, live);
+            p.half_w = p
+                .normal
+                .mass
+                .simd_gt(F4::ZERO)
+                .select(F4::splat(0.5) / p.normal.mass, F4::ZERO);
         }
         let lanes = F4::new(counts.map(|c| if c > 0 { f32::from_bits(!0) } else { 0.0 }));
         self.friction[bi].compute(&batch, (ma, &ia), (mb, &ib), lanes);
@@ -612,7 +649,11 @@ impl ContactSolver {
     /// Applies every accumulated impulse once (warm start).
     pub fn warm_start(&mut self) {
         self.for_each_batch(|batch, friction, points, _, [a, b]| {
-            for p in points.iter() {
+            for p in points.iter_mut() {
+                // The velocity the last pass left stands in for the present one (they differ
+                // by the forces of one substep): the hot loop does not pay for another
+                // relative velocity per point.
+                p.lost -= work(p.n_imp, p.vn_end, p.half_w);
                 Side::push(a, b, batch.n, &p.normal, p.n_imp);
             }
             friction.warm_start(batch, a, b);
@@ -656,7 +697,7 @@ impl ContactSolver {
     ) {
         let inv_h = F4::splat(1.0 / h);
         let max_push = F4::splat(-max_push);
-        let (zero, one) = (F4::ZERO, F4::ONE);
+        let (zero, one, two) = (F4::ZERO, F4::ONE, F4::splat(2.0));
         self.for_each_batch(|batch, friction, points, states, [a, b]| {
             let (dx_a, dr_a) = Self::motion(states, batch.a);
             let (dx_b, dr_b) = Self::motion(states, batch.b);
@@ -697,9 +738,16 @@ impl ContactSolver {
                 if first.any() {
                     let hit = impact_speed(vn, s, p.vn_seen, inv_h);
                     p.approach = first.select(p.approach.fast_min(hit), p.approach);
+                    p.vn_first = first.select(vn, p.vn_first);
                 }
                 p.n_imp = total;
                 p.max_n = p.max_n.fast_max(imp);
+                p.lost -= work(imp, vn, p.half_w);
+                if !BIAS {
+                    // The relax pass is each substep's last: n_imp is that substep's impulse.
+                    p.vn_end = vn + two * imp * p.half_w;
+                    p.absorbed += total;
+                }
                 Side::push(a, b, batch.n, &p.normal, imp);
             };
             if BIAS {
@@ -712,11 +760,17 @@ impl ContactSolver {
         });
     }
 
-    /// After the last substep: contacts that hit faster than `threshold` leave at −e times
-    /// their approach speed.
-    pub fn restitution(&mut self, threshold: f32) {
+    /// After the last substep: contacts that hit faster than their threshold leave at −e times
+    /// their approach speed (Newton's law), capped twice:
+    /// - at the impulse that ends the compression plus e times the whole compression impulse
+    ///   (Poisson's law): in a row of touching bodies the solve itself drives a contact that
+    ///   was not hit, and bouncing it off its own push would create energy;
+    /// - so that, over all points, the restitution gives back at most Σ e² times the kinetic
+    ///   energy the step's normal impulses took out. Impulses move energy between points (one
+    ///   point of a row pushes what another stopped), so the budget is the step's, not each
+    ///   point's; a point whose impulse would overdraw it is scaled down.
+    pub fn restitution(&mut self) {
         let zero = F4::ZERO;
-        let threshold = F4::splat(-threshold);
         let rest = self.rest();
         let Self {
             batches,
@@ -724,6 +778,22 @@ impl ContactSolver {
             states,
             ..
         } = self;
+        // The budget: e² of the energy lost, and of what the impact-speed extrapolation adds
+        // to an impact (the speed the substep's integration had not reached yet).
+        let mut budget = 0.0f32;
+        for batch in batches.iter() {
+            let e2 = batch.restitution * batch.restitution;
+            for p in &points[batch.first as usize..(batch.first + batch.count) as usize] {
+                let hit = p.approach.simd_lt(batch.threshold) & p.max_n.simd_gt(zero);
+                let m = p
+                    .half_w
+                    .simd_gt(zero)
+                    .select(F4::splat(0.25) / p.half_w, zero);
+                let extra = m * (p.approach * p.approach - p.vn_first * p.vn_first);
+                let extra = hit.select(extra.fast_max(zero), zero);
+                budget += (e2 * (p.lost + extra)).reduce_add();
+            }
+        }
         for batch in batches.iter() {
             let bouncy = batch.restitution.simd_gt(zero);
             if !bouncy.any() {
@@ -734,15 +804,28 @@ impl ContactSolver {
                 Self::load(states, batch.b, batch.inv_m_b),
             );
             for p in &mut points[batch.first as usize..(batch.first + batch.count) as usize] {
-                let hit = bouncy & p.approach.simd_lt(threshold) & p.max_n.simd_gt(zero);
+                let hit = bouncy & p.approach.simd_lt(batch.threshold) & p.max_n.simd_gt(zero);
                 if !hit.any() {
                     continue;
                 }
                 let vn = batch.n.dot(Side::relative(&a, &b, p.r_a, p.r_b));
-                let imp = -p.normal.mass * (vn + batch.restitution * p.approach);
-                let total = hit.select((p.n_imp + imp).fast_max(zero), p.n_imp);
-                let imp = total - p.n_imp;
-                p.n_imp = total;
+                let e = batch.restitution;
+                // Poisson: the impulse still needed to end the compression (a soft contact may
+                // not have stopped the approach by the step's end), then e times the whole
+                // compression impulse.
+                let finish = p.normal.mass * (-vn).fast_max(zero);
+                let poisson = finish + e * (p.absorbed + finish);
+                let wanted = (-p.normal.mass * (vn + e * p.approach)).fast_min(poisson);
+                let total = hit.select((p.n_imp + wanted).fast_max(zero), p.n_imp);
+                let mut imp = total - p.n_imp;
+                // work(s λ) ≤ s work(λ) for s in [0, 1]: scaling by the budget's share keeps
+                // the sum within it.
+                let cost = work(imp, vn, p.half_w).reduce_add();
+                if cost > budget {
+                    imp *= F4::splat((budget / cost).max(0.0));
+                }
+                budget -= work(imp, vn, p.half_w).reduce_add();
+                p.n_imp += imp;
                 Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
             }
             Self::store(states, rest, batch.a, &a);

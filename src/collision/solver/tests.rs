@@ -64,6 +64,7 @@ fn solver_with(bodies: usize, pairs: &[(u32, u32)]) -> ContactSolver {
             t: [Vec3A::X, Vec3A::Z],
             friction: 0.5,
             restitution: 0.0,
+            threshold: 1.0,
             first: mi as u32,
             count: 1,
             pair: (Entity::PLACEHOLDER, Entity::PLACEHOLDER),
