@@ -3,7 +3,6 @@
 //! bounces, 25 % early against the closed-form series. A collider's `RestitutionThreshold`
 //! now lowers it for its own contacts.
 
-use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::prelude::*;
 use hooke::{RestitutionThreshold, scenes};
