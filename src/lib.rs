@@ -164,9 +164,10 @@ use bevy_ecs::prelude::*;
 
 pub use cloth::{Cloth, ClothBuilder, ClothMaterial, ClothPlugin};
 pub use collision::{
-    Collider, ColliderDensity, ColliderOf, ColliderOffset, CollisionEventsEnabled, CollisionLayers,
-    CollisionPlugin, CombineRule, ContactEnd, ContactEnded, ContactSettings, ContactStart,
-    ContactStarted, Contacts, Friction, Restitution, RestitutionThreshold, Sensor, SpatialQuery,
+    Collider, ColliderChanges, ColliderDensity, ColliderOf, ColliderOffset, CollisionEventsEnabled,
+    CollisionLayers, CollisionPlugin, CombineRule, ContactEnd, ContactEnded, ContactSettings,
+    ContactStart, ContactStarted, Contacts, Friction, Restitution, RestitutionThreshold, Sensor,
+    SpatialQuery,
 };
 pub use diagnostics::{DiagnosticsSettings, PhysicsDiagnostics};
 pub use error::{Error, Result};

@@ -69,7 +69,11 @@ impl WorldPlugin for SleepPlugin {
         add_systems(
             world,
             PhysicsSchedule,
-            (wake_on_user_change, update_islands)
+            (
+                wake_on_user_change,
+                wake_on_structural_change,
+                update_islands,
+            )
                 .chain()
                 .run_if(any_with_component::<Collider>)
                 .in_set(PrepareSystems::Sleep),
@@ -108,6 +112,66 @@ fn wake_on_user_change(
     for (e, mut timer) in &mut disturbed {
         // A woken body starts its stillness count afresh, or it would fall straight back asleep.
         timer.0 = 0.0;
+        commands.entity(e).remove::<Sleeping>();
+    }
+}
+
+/// A collider was removed, despawned, replaced or resized: every sleeping island that touched
+/// it wakes, so that a stack whose middle box or ground went falls (it floated before).
+fn wake_on_structural_change(
+    mut commands: Commands,
+    changes: Option<Res<crate::collision::ColliderChanges>>,
+    contacts: Res<Contacts>,
+    mut sleepers: Query<&mut SleepTimer, With<Sleeping>>,
+) {
+    let Some(changes) = changes.filter(|c| !c.entities().is_empty()) else {
+        return;
+    };
+    if sleepers.is_empty() {
+        return;
+    }
+    let changed: bevy_platform::collections::HashSet<Entity> =
+        changes.entities().iter().copied().collect();
+    let touching = contacts.touching();
+    let mut stack: Vec<Entity> = touching
+        .iter()
+        .filter_map(|&(a, b)| {
+            if changed.contains(&a) {
+                Some(b)
+            } else if changed.contains(&b) {
+                Some(a)
+            } else {
+                None
+            }
+        })
+        .chain(changed.iter().copied())
+        .filter(|&e| sleepers.contains(e))
+        .collect();
+    // The islands: through the touching pairs of sleepers.
+    let mut woken = bevy_platform::collections::HashSet::new();
+    while let Some(e) = stack.pop() {
+        if !woken.insert(e) {
+            continue;
+        }
+        for &(a, b) in &touching {
+            let other = if a == e {
+                b
+            } else if b == e {
+                a
+            } else {
+                continue;
+            };
+            if !woken.contains(&other) && sleepers.contains(other) {
+                stack.push(other);
+            }
+        }
+    }
+    let mut woken: Vec<Entity> = woken.into_iter().collect();
+    woken.sort_unstable();
+    for e in woken {
+        if let Ok(mut timer) = sleepers.get_mut(e) {
+            timer.0 = 0.0;
+        }
         commands.entity(e).remove::<Sleeping>();
     }
 }

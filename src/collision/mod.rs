@@ -103,11 +103,29 @@ fn collider_changed(
     ctx: bevy_ecs::lifecycle::HookContext,
 ) {
     broad::mark_dirty(&mut world, ctx.entity);
+    if let Some(mut changes) = world.get_resource_mut::<ColliderChanges>() {
+        changes.0.push(ctx.entity);
+    }
     if world
         .get::<Collider>(ctx.entity)
         .is_some_and(|c| !c.composed)
     {
         attach::queue_refresh_owner(&mut world, ctx.entity);
+    }
+}
+
+/// Colliders inserted, replaced or removed (a despawn included) since the last step's
+/// collision detection: what touched them must hear of it (the sleep plugin wakes their
+/// islands, whose pairs the narrow phase then updates or ends).
+#[derive(Resource, Debug, Default)]
+pub struct ColliderChanges(pub(crate) Vec<Entity>);
+
+impl ColliderChanges {
+    /// The entities whose collider changed or went, in the order it happened (one may
+    /// appear more than once).
+    #[must_use]
+    pub fn entities(&self) -> &[Entity] {
+        &self.0
     }
 }
 

@@ -32,6 +32,7 @@ pub struct CollisionPlugin;
 impl WorldPlugin for CollisionPlugin {
     fn build(&self, world: &mut World) {
         world.init_resource::<ContactSettings>();
+        world.init_resource::<super::ColliderChanges>();
         world.init_resource::<BroadPhase>();
         world.init_resource::<Contacts>();
         world.init_resource::<ContactSolver>();
@@ -63,6 +64,7 @@ impl WorldPlugin for CollisionPlugin {
             PhysicsSchedule,
             (
                 (
+                    clear_collider_changes,
                     update_moving_aabbs,
                     update_fixed_aabbs.run_if(fixed_dirty),
                     run_broad_phase,
@@ -88,6 +90,15 @@ impl WorldPlugin for CollisionPlugin {
                     .in_set(crate::schedule::RelaxSystems::Rigid),
             ),
         );
+    }
+}
+
+/// Empties [`super::ColliderChanges`] once the step's inputs have read it (the sleep plugin
+/// wakes the islands that touched a changed collider; their pairs then end through the
+/// narrow phase like any other, with their messages).
+fn clear_collider_changes(mut changes: ResMut<super::ColliderChanges>) {
+    if !changes.0.is_empty() {
+        changes.0.clear();
     }
 }
 
