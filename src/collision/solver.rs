@@ -760,79 +760,6 @@ impl ContactSolver {
         });
     }
 
-    /// After the last substep: contacts that hit faster than their threshold leave at −e times
-    /// their approach speed (Newton's law), capped twice:
-    /// - at the impulse that ends the compression plus e times the whole compression impulse
-    ///   (Poisson's law): in a row of touching bodies the solve itself drives a contact that
-    ///   was not hit, and bouncing it off its own push would create energy;
-    /// - so that, over all points, the restitution gives back at most Σ e² times the kinetic
-    ///   energy the step's normal impulses took out. Impulses move energy between points (one
-    ///   point of a row pushes what another stopped), so the budget is the step's, not each
-    ///   point's; a point whose impulse would overdraw it is scaled down.
-    pub fn restitution(&mut self) {
-        let zero = F4::ZERO;
-        let rest = self.rest();
-        let Self {
-            batches,
-            points,
-            states,
-            ..
-        } = self;
-        // The budget: e² of the energy lost, and of what the impact-speed extrapolation adds
-        // to an impact (the speed the substep's integration had not reached yet).
-        let mut budget = 0.0f32;
-        for batch in batches.iter() {
-            let e2 = batch.restitution * batch.restitution;
-            for p in &points[batch.first as usize..(batch.first + batch.count) as usize] {
-                let hit = p.approach.simd_lt(batch.threshold) & p.max_n.simd_gt(zero);
-                let m = p
-                    .half_w
-                    .simd_gt(zero)
-                    .select(F4::splat(0.25) / p.half_w, zero);
-                let extra = m * (p.approach * p.approach - p.vn_first * p.vn_first);
-                let extra = hit.select(extra.fast_max(zero), zero);
-                budget += (e2 * (p.lost + extra)).reduce_add();
-            }
-        }
-        for batch in batches.iter() {
-            let bouncy = batch.restitution.simd_gt(zero);
-            if !bouncy.any() {
-                continue;
-            }
-            let (mut a, mut b) = (
-                Self::load(states, batch.a, batch.inv_m_a),
-                Self::load(states, batch.b, batch.inv_m_b),
-            );
-            for p in &mut points[batch.first as usize..(batch.first + batch.count) as usize] {
-                let hit = bouncy & p.approach.simd_lt(batch.threshold) & p.max_n.simd_gt(zero);
-                if !hit.any() {
-                    continue;
-                }
-                let vn = batch.n.dot(Side::relative(&a, &b, p.r_a, p.r_b));
-                let e = batch.restitution;
-                // Poisson: the impulse still needed to end the compression (a soft contact may
-                // not have stopped the approach by the step's end), then e times the whole
-                // compression impulse.
-                let finish = p.normal.mass * (-vn).fast_max(zero);
-                let poisson = finish + e * (p.absorbed + finish);
-                let wanted = (-p.normal.mass * (vn + e * p.approach)).fast_min(poisson);
-                let total = hit.select((p.n_imp + wanted).fast_max(zero), p.n_imp);
-                let mut imp = total - p.n_imp;
-                // work(s λ) ≤ s work(λ) for s in [0, 1]: scaling by the budget's share keeps
-                // the sum within it.
-                let cost = work(imp, vn, p.half_w).reduce_add();
-                if cost > budget {
-                    imp *= F4::splat((budget / cost).max(0.0));
-                }
-                budget -= work(imp, vn, p.half_w).reduce_add();
-                p.n_imp += imp;
-                Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
-            }
-            Self::store(states, rest, batch.a, &a);
-            Self::store(states, rest, batch.b, &b);
-        }
-    }
-
     /// Each manifold's accumulated impulses, for the next step's warm start: its
     /// constraint, the normal impulse of each solved point (by its index in the narrow
     /// phase's manifold), the friction impulse at its centre (world frame) and the twist.
@@ -874,6 +801,7 @@ pub(crate) struct SolvedManifold<'a> {
 }
 
 mod friction;
+mod restitution;
 
 #[cfg(test)]
 mod tests;
