@@ -94,6 +94,31 @@ fn bad_cloth_meshes_are_typed_errors() {
 }
 
 #[test]
+fn a_strain_limited_cloth_whose_network_is_replaced_does_not_panic() {
+    let mut w = world(4, G);
+    let (nodes, net, cloth) = ClothBuilder::new(Vec3::new(0.0, 2.0, 0.0), 6, 6, 0.1)
+        .build_cloth()
+        .unwrap();
+    let cloth = cloth.with_strain_limit(Some(0.1)).unwrap();
+    let e = w.spawn((nodes, net, cloth)).id();
+    w.step_physics();
+    // Game code swaps in a network of one spring: the cloth's structural list no longer fits.
+    let mut small = SpringNetwork::new();
+    small.push(0, 1, 0.1, 8.0, 0.01).unwrap();
+    w.entity_mut(e).insert(small);
+    for _ in 0..10 {
+        w.step_physics();
+    }
+    assert!(
+        w.get::<Nodes>(e)
+            .unwrap()
+            .positions()
+            .iter()
+            .all(|x| x.is_finite())
+    );
+}
+
+#[test]
 fn absurd_builder_sizes_are_errors_not_allocation_panics() {
     let huge = ClothBuilder::new(Vec3::ZERO, usize::MAX, 3, 0.1).build();
     assert!(matches!(huge, Err(Error::OutOfRange { .. })), "{huge:?}");

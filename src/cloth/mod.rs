@@ -45,6 +45,10 @@ pub struct Cloth {
     triangles: Vec<[u32; 3]>,
     /// The springs strain limiting holds (the structural ones).
     structural: Vec<u32>,
+    /// The largest corner index and the largest structural spring index (both fixed at
+    /// construction), so one comparison per step proves a mesh still fits.
+    max_corner: u32,
+    max_structural: Option<u32>,
     normals: Vec<Vec3A>,
     drag: f32,
     strain_limit: Option<f32>,
@@ -182,6 +186,8 @@ impl Cloth {
 
     pub(crate) fn new(triangles: Vec<[u32; 3]>, structural: Vec<u32>, nodes: usize) -> Self {
         Self {
+            max_corner: triangles.iter().flatten().copied().max().unwrap_or(0),
+            max_structural: structural.iter().copied().max(),
             triangles,
             structural,
             normals: vec![Vec3A::ZERO; nodes],
@@ -264,8 +270,15 @@ impl Cloth {
 
     /// Whether every triangle indexes into `nodes`.
     pub(crate) fn fits(&self, nodes: &Nodes) -> bool {
-        let n = nodes.len() as u32;
-        self.triangles.iter().flatten().all(|&i| i < n) && self.normals.len() == nodes.len()
+        (self.triangles.is_empty() || (self.max_corner as usize) < nodes.len())
+            && self.normals.len() == nodes.len()
+    }
+
+    /// Whether every structural spring indexes into `springs` (game code may have replaced
+    /// the network with another).
+    pub(crate) fn fits_springs(&self, springs: &SpringNetwork) -> bool {
+        self.max_structural
+            .is_none_or(|m| (m as usize) < springs.len())
     }
 }
 

@@ -116,7 +116,8 @@ fn limit_strain(mut cloths: Query<(&mut Nodes, &SpringNetwork, &Cloth), Live>) {
             continue;
         };
         let n = nodes.bypass_change_detection();
-        if !net.fits(n) {
+        // A network swapped for a smaller one would index past its springs: no limiting.
+        if !(net.fits(n) && cloth.fits_springs(net)) {
             continue;
         }
         let Nodes { x, v, inv_mass, .. } = n;
