@@ -48,6 +48,9 @@ pub(crate) struct PairState {
     pub seen: u64,
     /// Where the last full update ran, while its manifolds may be reused.
     pub recycle: Option<Recycle>,
+    /// This step's time-of-impact manifold for a fast pair (see the `ccd` module): solved
+    /// after `manifolds`, found anew every step, never warm-started.
+    pub cast: Option<Manifold>,
 }
 
 /// The relative pose and reach of a pair's last full manifold update.
@@ -68,13 +71,19 @@ pub(crate) struct Recycle {
 
 impl Recycle {
     /// True when manifolds found at `self` still hold at `pos12` for a prediction of
-    /// `prediction`, the second shape lying within `extent` of its origin.
+    /// `prediction`, the second shape lying within `extent` of its origin, and the pair moved
+    /// at most `window` since.
+    ///
+    /// The drift must stay within the window even when the prediction shrank: parry's
+    /// manifold holds the closest features and their neighbours, not every feature within
+    /// its reach, so a fast body that slowed down (its reach metres deep) kept points from
+    /// metres back, and a box stopped short of a thin wall then went through it.
     #[must_use]
-    pub fn holds(&self, pos12: &Pose, extent: f32, prediction: f32) -> bool {
+    pub fn holds(&self, pos12: &Pose, extent: f32, prediction: f32, window: f32) -> bool {
         let turn = self.pos12.rotation.inverse() * pos12.rotation;
         let drift = (pos12.translation - self.pos12.translation).length()
             + 2.0 * turn.xyz().length() * extent;
-        drift + prediction <= self.reach
+        drift <= window && drift + prediction <= self.reach
     }
 }
 
@@ -87,7 +96,13 @@ impl PairState {
             sensor: false,
             seen: 0,
             recycle: None,
+            cast: None,
         }
+    }
+
+    /// The manifolds the solver takes: parry's, then the time-of-impact one.
+    pub fn solved(&self) -> impl Iterator<Item = &Manifold> {
+        self.manifolds.iter().chain(&self.cast)
     }
 }
 
@@ -389,9 +404,14 @@ mod tests {
             pos12: then,
             reach: prediction + bound + slack,
         };
-        assert!(reach(1e-5).holds(&now, extent, prediction));
-        assert!(!reach(-1e-5).holds(&now, extent, prediction));
+        let window = bound + 1e-5;
+        assert!(reach(1e-5).holds(&now, extent, prediction, window));
+        assert!(!reach(-1e-5).holds(&now, extent, prediction, window));
         // A faster pair asks for a deeper prediction, which the old search may not cover.
-        assert!(!reach(1e-5).holds(&now, extent, prediction + 2e-5));
+        assert!(!reach(1e-5).holds(&now, extent, prediction + 2e-5, window));
+        // A pair that slowed down has a reach deeper than it needs now, but its manifold
+        // holds the closest features of then, not every feature within that reach: past
+        // the window it is found again.
+        assert!(!reach(10.0).holds(&now, extent, prediction, bound - 1e-5));
     }
 }

@@ -289,6 +289,15 @@ type NarrowCollider<'a> = (
 struct NarrowBody<'a> {
     collider: &'a Collider,
     pose: Pose,
+    /// Velocity of the centre of mass (m/s; zero for static colliders).
+    velocity: Vec3,
+    /// Angular velocity (rad/s; zero for static colliders).
+    spin: Vec3,
+    /// Centre of mass in the shape's frame (m) and how far the shape reaches from it.
+    centre: Vec3,
+    radius: f32,
+    /// How thin the shape is (m; see [`super::ccd::thickness`]).
+    thin: f32,
     /// Fastest speed of any point of the shape (m/s): |v| + |ω| r.
     speed: f32,
     /// Farthest any point of the shape is from the shape's origin (m).
@@ -296,6 +305,19 @@ struct NarrowBody<'a> {
     /// The collider was replaced or changed since the last step.
     changed: bool,
     sensor: bool,
+}
+
+impl<'a> NarrowBody<'a> {
+    fn cast_side(&self) -> super::ccd::CastSide<'a> {
+        super::ccd::CastSide {
+            shape: &**self.collider.shape(),
+            pose: self.pose,
+            velocity: self.velocity,
+            spin: self.spin,
+            centre: self.centre,
+            radius: self.radius,
+        }
+    }
 }
 
 fn narrow_body<'a>(
@@ -309,6 +331,11 @@ fn narrow_body<'a>(
     NarrowBody {
         collider,
         pose: shape_pose(x.0, q.0, com),
+        velocity: v.map_or(Vec3::ZERO, |v| v.0.into()),
+        spin: w.map_or(Vec3::ZERO, |w| w.0.into()),
+        centre: com.map_or(Vec3::ZERO, |c| c.0),
+        radius: radius(collider, com),
+        thin: super::ccd::thickness([lo, hi]),
         speed,
         extent: lo.abs().max(hi.abs()).length(),
         changed,
@@ -367,6 +394,7 @@ fn update_contacts(
         let state = contacts.pairs.entry((a, b)).or_insert_with(PairState::new);
         state.seen = step;
         state.sensor = sensor;
+        state.cast = None;
         let touching = if sensor {
             let (sa, sb) = (&**ca.collider.shape(), &**cb.collider.shape());
             parry3d::query::intersection_test(pose_a, sa, pose_b, sb).is_ok_and(|i| i.intersecting)
@@ -375,7 +403,7 @@ fn update_contacts(
             let pos12 = pose_a.inverse() * *pose_b;
             let changed = ca.changed || cb.changed;
             match state.recycle {
-                Some(r) if !changed && r.holds(&pos12, cb.extent, prediction) => {
+                Some(r) if !changed && r.holds(&pos12, cb.extent, prediction, window) => {
                     for m in &mut state.manifolds {
                         m.update_separations(&part_pose12(m, &pos12));
                     }
@@ -405,6 +433,17 @@ fn update_contacts(
                         choose_points(m, scratch);
                     }
                 }
+            }
+            let (side_a, side_b, thin) = (ca.cast_side(), cb.cast_side(), ca.thin.min(cb.thin));
+            if super::ccd::is_fast(&side_a, &side_b, dt, thin) {
+                state.cast = super::ccd::impact_manifold(
+                    &side_a,
+                    &side_b,
+                    dt,
+                    thin,
+                    &state.manifolds,
+                    scratch,
+                );
             }
             state
                 .manifolds
@@ -464,6 +503,7 @@ fn trigger_contact_events(
 
 type PreparedBody<'a> = (
     Entity,
+    &'a Collider,
     &'a Position,
     &'a Rotation,
     Option<&'a CenterOfMass>,
@@ -489,6 +529,8 @@ struct Side {
     /// Velocity and angular velocity (zero for a [`FIXED`] side).
     v: Vec3A,
     w: Vec3A,
+    /// What the anchors of its contact points need of its shape.
+    round: Roundness,
     friction: f32,
     restitution: f32,
     /// The collider's own restitution threshold (m/s), if it has one.
@@ -504,10 +546,24 @@ impl Side {
     const UNSET: u32 = u32::MAX - 1;
 
     fn new(body: bevy_ecs::query::ROQueryItem<'_, '_, PreparedBody>) -> Self {
-        let (entity, x, q, com, mass, v, inertia, w, friction, restitution, threshold, sleeping) =
-            body;
+        let (
+            entity,
+            collider,
+            x,
+            q,
+            com,
+            mass,
+            v,
+            inertia,
+            w,
+            friction,
+            restitution,
+            threshold,
+            sleeping,
+        ) = body;
         Side {
             entity,
+            round: Roundness::of(collider.shape()),
             index: Side::UNSET,
             x: x.0,
             q: q.0,
@@ -521,6 +577,53 @@ impl Side {
             moves: v.is_some() && !sleeping,
             inertia: inertia.copied(),
         }
+    }
+}
+
+/// How far a collider's contact points may be anchored inside it: the radius of a round
+/// shape (a ball, a capsule).
+///
+/// A round shape's support point in a direction does not turn with it: it is the centre of
+/// the ball (or of the capsule's cap) plus r times the direction. So its contact point is
+/// anchored there, r inside its surface along the normal: the normal passes through it, so
+/// the normal's effective mass and velocity are the same, and the separation the solver
+/// updates from the anchors (n·(Δx + ΔR r)) is not thrown off by the body's spin. Anchored
+/// on its surface, a ball spun by friction (a ball glancing off a wall at 70 m/s spins at
+/// 170 rad/s) read its gap as wider than it was and went through a thin wall.
+enum Roundness {
+    Round(f32),
+    /// A compound: its parts are looked up per manifold.
+    Parts(parry3d::shape::SharedShape),
+}
+
+impl Roundness {
+    fn of(shape: &parry3d::shape::SharedShape) -> Self {
+        if shape.as_compound().is_some() {
+            Roundness::Parts(shape.clone())
+        } else {
+            Roundness::Round(round_radius(&**shape))
+        }
+    }
+
+    /// The radius of the manifold's part (0 when it is not round).
+    fn radius(&self, part: u32) -> f32 {
+        match self {
+            Roundness::Round(r) => *r,
+            Roundness::Parts(shape) => shape
+                .as_compound()
+                .and_then(|c| c.shapes().get(part as usize))
+                .map_or(0.0, |(_, s)| round_radius(&**s)),
+        }
+    }
+}
+
+fn round_radius(shape: &dyn parry3d::shape::Shape) -> f32 {
+    if let Some(b) = shape.as_ball() {
+        b.radius
+    } else if let Some(c) = shape.as_capsule() {
+        c.radius
+    } else {
+        0.0
     }
 }
 
@@ -615,6 +718,7 @@ fn prepare_contacts(
 ) {
     let s = &mut *solver;
     s.clear();
+    let touch = 0.25 * settings.margin;
     let (wanted, pairs, sides) = &mut *buffers;
     wanted.clear();
     pairs.clear();
@@ -622,7 +726,7 @@ fn prepare_contacts(
         let Some(state) = contacts.pairs.get(&(ea, eb)) else {
             continue;
         };
-        if state.sensor || state.manifolds.iter().all(|m| m.points.is_empty()) {
+        if state.sensor || state.solved().all(|m| m.points.is_empty()) {
             continue;
         }
         pairs.push((ea, eb, wanted.slot(ea) as u32, wanted.slot(eb) as u32));
@@ -659,7 +763,7 @@ fn prepare_contacts(
             (Some(x), None) | (None, Some(x)) => x,
             (None, None) => settings.restitution_threshold,
         };
-        for (mi, m) in state.manifolds.iter().enumerate() {
+        for (mi, m) in state.solved().enumerate() {
             if m.points.is_empty() {
                 continue;
             }
@@ -674,19 +778,46 @@ fn prepare_contacts(
             let kept = m.data.kept();
             let count = kept.len();
             let mut mids = [Vec3A::ZERO; super::narrow::MAX_POINTS];
-            for (mid, &k) in mids.iter_mut().zip(kept) {
+            let mut witness = [(Vec3A::ZERO, Vec3A::ZERO); super::narrow::MAX_POINTS];
+            for ((mid, w), &k) in mids.iter_mut().zip(&mut witness).zip(kept) {
                 let p = &m.points[usize::from(k)];
-                *mid = 0.5 * (Vec3A::from(pose_a * p.local_p1) + Vec3A::from(pose_b * p.local_p2));
+                *w = (
+                    Vec3A::from(pose_a * p.local_p1),
+                    Vec3A::from(pose_b * p.local_p2),
+                );
+                *mid = 0.5 * (w.0 + w.1);
             }
+            // A round side's points are anchored at its centre of curvature (see
+            // `Roundness`).
+            let (round_a, round_b) = (a.round.radius(m.subshape1), b.round.radius(m.subshape2));
             let mids = &mids[..count];
             // Friction acts at the kept points' centre; the twist's arm is their mean
             // distance from it.
             let middle = mids.iter().sum::<Vec3A>() / count as f32;
             let t = tangent_basis(n, m, middle, (a.x, va, wa), (b.x, vb, wb));
             let radius = mids.iter().map(|&p| (p - middle).length()).sum::<f32>() / count as f32;
-            for (&k, &mid) in kept.iter().zip(mids) {
+            for ((&k, &mid), &(w_a, w_b)) in kept.iter().zip(mids).zip(&witness) {
                 let p = &m.points[usize::from(k)];
-                let (r_a, r_b) = (mid - a.x, mid - b.x);
+                // A touching point acts at the middle of its two witness points. A
+                // speculative one, with a gap still open, acts on each body where that body
+                // will touch: anchored in the gap, its lever arms were as long as the gap
+                // (metres for a fast body), and friction on them spun the body.
+                let (p_a, p_b) = if p.dist > touch {
+                    (w_a, w_b)
+                } else {
+                    (mid, mid)
+                };
+                let p_a = if round_a > 0.0 {
+                    w_a - n * round_a
+                } else {
+                    p_a
+                };
+                let p_b = if round_b > 0.0 {
+                    w_b + n * round_b
+                } else {
+                    p_b
+                };
+                let (r_a, r_b) = (p_a - a.x, p_b - b.x);
                 let rel = (vb + wb.cross(r_b)) - (va + wa.cross(r_a));
                 s.inputs.push(PointInput {
                     r_a,
@@ -740,6 +871,7 @@ fn solve_contacts(
     mut bodies: Query<SolvedBody, Live>,
 ) {
     gather(&mut solver, &bodies);
+    solver.limit_rotation(settings.max_rotation / time.h);
     let (soft, fixed) = softness(&settings, time.h);
     solver.warm_start();
     solver.solve(time.h, soft, fixed, true, settings.max_push_velocity);
@@ -769,6 +901,8 @@ fn relax_contacts(
             else {
                 continue;
             };
+            // (The time-of-impact manifold, after parry's, is not found here: it is not
+            // warm-started.)
             // Points the solver left out (beyond four) start from zero if kept later.
             for p in &mut tracked.points {
                 p.data = ContactImpulse::default();

@@ -646,6 +646,22 @@ impl ContactSolver {
         }
     }
 
+    /// Scales down the angular velocity of every dynamic body spinning faster than
+    /// `max_w` (rad/s; not a positive number: no limit). The write-back turns the change
+    /// into the angular momentum, so the limit only ever takes energy out.
+    pub fn limit_rotation(&mut self, max_w: f32) {
+        if max_w.is_nan() || max_w <= 0.0 {
+            return;
+        }
+        let max2 = max_w * max_w;
+        for (b, s) in self.bodies.iter().zip(&mut self.states) {
+            let w2 = s.w.length_squared();
+            if b.dynamic && w2 > max2 {
+                s.w *= max_w / w2.sqrt();
+            }
+        }
+    }
+
     /// Applies every accumulated impulse once (warm start).
     pub fn warm_start(&mut self) {
         self.for_each_batch(|batch, friction, points, _, [a, b]| {
