@@ -296,6 +296,8 @@ struct NarrowBody<'a> {
     /// Centre of mass in the shape's frame (m) and how far the shape reaches from it.
     centre: Vec3,
     radius: f32,
+    /// The fastest speed its spin gives any of its points, |ω| r (m/s).
+    swing: f32,
     /// How thin the shape is (m; see [`super::ccd::thickness`]).
     thin: f32,
     /// Fastest speed of any point of the shape (m/s): |v| + |ω| r.
@@ -326,15 +328,17 @@ fn narrow_body<'a>(
     let changed = collider.is_changed();
     let collider = collider.into_inner();
     let [lo, hi] = collider.local_bounds();
-    let speed =
-        v.map_or(0.0, |v| v.0.length()) + w.map_or(0.0, |w| w.0.length() * radius(collider, com));
+    let reach = radius(collider, com);
+    let swing = w.map_or(0.0, |w| w.0.length() * reach);
+    let speed = v.map_or(0.0, |v| v.0.length()) + swing;
     NarrowBody {
         collider,
         pose: shape_pose(x.0, q.0, com),
         velocity: v.map_or(Vec3::ZERO, |v| v.0.into()),
         spin: w.map_or(Vec3::ZERO, |w| w.0.into()),
         centre: com.map_or(Vec3::ZERO, |c| c.0),
-        radius: radius(collider, com),
+        radius: reach,
+        swing,
         thin: super::ccd::thickness([lo, hi]),
         speed,
         extent: lo.abs().max(hi.abs()).length(),
@@ -434,11 +438,14 @@ fn update_contacts(
                     }
                 }
             }
-            let (side_a, side_b, thin) = (ca.cast_side(), cb.cast_side(), ca.thin.min(cb.thin));
-            if super::ccd::is_fast(&side_a, &side_b, dt, thin) {
+            // A triangle mesh or heightfield is zero thick: without the margin as a floor,
+            // every pair moving on one at all would be cast every step.
+            let thin = ca.thin.min(cb.thin).max(settings.margin);
+            let sweep = (cb.velocity - ca.velocity).length() + ca.swing.max(cb.swing);
+            if super::ccd::is_fast(sweep, dt, thin) {
                 state.cast = super::ccd::impact_manifold(
-                    &side_a,
-                    &side_b,
+                    &ca.cast_side(),
+                    &cb.cast_side(),
                     dt,
                     thin,
                     &state.manifolds,
@@ -598,7 +605,7 @@ enum Roundness {
 
 impl Roundness {
     fn of(shape: &parry3d::shape::SharedShape) -> Self {
-        if shape.as_compound().is_some() {
+        if shape.shape_type() == parry3d::shape::ShapeType::Compound {
             Roundness::Parts(shape.clone())
         } else {
             Roundness::Round(round_radius(&**shape))
@@ -618,12 +625,12 @@ impl Roundness {
 }
 
 fn round_radius(shape: &dyn parry3d::shape::Shape) -> f32 {
-    if let Some(b) = shape.as_ball() {
-        b.radius
-    } else if let Some(c) = shape.as_capsule() {
-        c.radius
-    } else {
-        0.0
+    use parry3d::shape::ShapeType;
+    // One virtual call for the common shapes; a downcast only for the round ones.
+    match shape.shape_type() {
+        ShapeType::Ball => shape.as_ball().map_or(0.0, |b| b.radius),
+        ShapeType::Capsule => shape.as_capsule().map_or(0.0, |c| c.radius),
+        _ => 0.0,
     }
 }
 
