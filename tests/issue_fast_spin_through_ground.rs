@@ -11,6 +11,17 @@ use glam::Vec3;
 use hooke::prelude::*;
 use hooke::{ContactSettings, PhysicsDiagnostics, scenes};
 
+/// A unit box (1000 kg) with its centre at height `y`, spinning at `omega` (rad/s).
+fn spinning_box(w: &mut World, y: f32, omega: Vec3) -> Entity {
+    w.spawn((
+        RigidBody::Dynamic,
+        Collider::cuboid(0.5, 0.5, 0.5).unwrap(),
+        Position::from(Vec3::new(0.0, y, 0.0)),
+        AngularVelocity::from(omega),
+    ))
+    .id()
+}
+
 struct Outcome {
     lowest: f32,
     gain: f64,
@@ -23,14 +34,7 @@ fn spin_on_ground(omega: Vec3) -> Outcome {
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
     scenes::ground(&mut w).unwrap();
-    let body = w
-        .spawn((
-            RigidBody::Dynamic,
-            Collider::cuboid(0.5, 0.5, 0.5).unwrap(),
-            Position::from(Vec3::new(0.0, 0.5, 0.0)),
-            AngularVelocity::from(omega),
-        ))
-        .id();
+    let body = spinning_box(&mut w, 0.5, omega);
     let energy = |w: &World| {
         let d = w.resource::<PhysicsDiagnostics>();
         d.kinetic_energy + d.gravitational_energy
@@ -88,14 +92,7 @@ fn a_body_in_free_flight_keeps_its_spin() {
     w.add_physics(PhysicsPlugins);
     w.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
     let omega = Vec3::new(0.0, 1000.0, 0.0);
-    let body = w
-        .spawn((
-            RigidBody::Dynamic,
-            Collider::cuboid(0.5, 0.5, 0.5).unwrap(),
-            Position::from(Vec3::new(0.0, 5.0, 0.0)),
-            AngularVelocity::from(omega),
-        ))
-        .id();
+    let body = spinning_box(&mut w, 5.0, omega);
     for _ in 0..120 {
         w.step_physics();
     }
@@ -109,15 +106,8 @@ fn the_rotation_limit_can_be_lifted() {
     w.add_physics(PhysicsPlugins);
     w.resource_mut::<ContactSettings>().max_rotation = f32::INFINITY;
     scenes::ground(&mut w).unwrap();
-    let body = w
-        .spawn((
-            RigidBody::Dynamic,
-            Collider::cuboid(0.5, 0.5, 0.5).unwrap(),
-            Position::from(Vec3::new(0.0, 0.5, 0.0)),
-            // About the vertical: spinning in place on its face, friction slows it.
-            AngularVelocity::from(Vec3::new(0.0, 1000.0, 0.0)),
-        ))
-        .id();
+    // About the vertical: spinning in place on its face, friction slows it.
+    let body = spinning_box(&mut w, 0.5, Vec3::new(0.0, 1000.0, 0.0));
     w.step_physics();
     let after = w.get::<AngularVelocity>(body).unwrap().get().length();
     // Only friction acted: far above the 120 rad/s the default limit would leave.
