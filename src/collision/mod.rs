@@ -58,6 +58,7 @@ mod lanes;
 mod narrow;
 pub(crate) mod nodes;
 mod plugin;
+mod prepare;
 mod query;
 mod solver;
 

@@ -1,7 +1,7 @@
 //! Collision systems: bounding boxes, broad phase, narrow phase, contact solver.
 
 use bevy_ecs::prelude::*;
-use glam::{Mat3A, Quat, Vec3, Vec3A};
+use glam::{Quat, Vec3, Vec3A};
 use parry3d::math::Pose;
 use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 
@@ -9,16 +9,14 @@ use super::broad::{BroadPhase, Entry};
 use super::exchange::{Live, SolvedBody, gather, scatter};
 use super::fetch::Wanted;
 use super::narrow::{ContactImpulse, Contacts, PairState, Recycle, choose_points};
-use super::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, Softness, SolverBody};
+use super::solver::{ContactSolver, Softness};
 use super::{
-    Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted,
-    Friction, Restitution, RestitutionThreshold, Sensor,
+    Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted, Sensor,
 };
 use crate::WorldPlugin;
-use crate::integrator::ConstraintsActive;
-use crate::particles::{LinearVelocity, Mass, Position};
+use crate::particles::{LinearVelocity, Position};
 use crate::rest::Sleeping;
-use crate::rigid::{AngularVelocity, CenterOfMass, Inertia, Rotation};
+use crate::rigid::{AngularVelocity, CenterOfMass, Rotation};
 use crate::schedule::{
     CollisionSystems, PhysicsSchedule, StepSystems, SubstepSchedule, add_systems,
 };
@@ -74,7 +72,7 @@ impl WorldPlugin for CollisionPlugin {
                 )
                     .chain()
                     .in_set(CollisionSystems::Detect),
-                prepare_contacts.in_set(CollisionSystems::Constraints),
+                super::prepare::prepare_contacts.in_set(CollisionSystems::Constraints),
             )
                 .run_if(any_with_component::<Collider>.or_else(has_contacts)),
         );
@@ -129,7 +127,7 @@ fn part_pose12(m: &super::narrow::Manifold, pos12: &Pose) -> Pose {
 
 /// The world pose of a manifold's part: the shape's pose, then the part's pose in it.
 #[inline]
-fn part_pose(shape: &Pose, part: Option<&Pose>) -> Pose {
+pub(super) fn part_pose(shape: &Pose, part: Option<&Pose>) -> Pose {
     part.map_or(*shape, |p| *shape * *p)
 }
 
@@ -347,10 +345,6 @@ fn narrow_body<'a>(
     }
 }
 
-/// Constraint building's reused buffers: the bodies of the step's contacts, the contact
-/// pairs with their slots among them, and the bodies' sides.
-type PrepareBuffers = (Wanted, Vec<(Entity, Entity, u32, u32)>, Vec<Option<Side>>);
-
 /// The narrow phase's reused buffers: the bodies of the step's pairs, the pairs' slots
 /// among them, and the point list of the point choice.
 type NarrowBuffers = (Wanted, Vec<(u32, u32)>, Vec<(Vec3A, f32, bool)>);
@@ -506,358 +500,6 @@ fn trigger_contact_events(
             }
         }
     }
-}
-
-type PreparedBody<'a> = (
-    Entity,
-    &'a Collider,
-    &'a Position,
-    &'a Rotation,
-    Option<&'a CenterOfMass>,
-    Option<&'a Mass>,
-    Option<&'a LinearVelocity>,
-    Option<&'a Inertia>,
-    Option<&'a AngularVelocity>,
-    &'a Friction,
-    &'a Restitution,
-    Option<&'a RestitutionThreshold>,
-    Has<Sleeping>,
-);
-
-/// One side of the step's contacts as constraint building needs it, fetched once per step
-/// however many pairs its body is in.
-struct Side {
-    entity: Entity,
-    /// Solver index, [`FIXED`], or [`Side::UNSET`] until a contact first needs it.
-    index: u32,
-    x: Vec3A,
-    q: Quat,
-    pose: Pose,
-    /// Velocity and angular velocity (zero for a [`FIXED`] side).
-    v: Vec3A,
-    w: Vec3A,
-    /// What the anchors of its contact points need of its shape.
-    round: Roundness,
-    friction: f32,
-    restitution: f32,
-    /// The collider's own restitution threshold (m/s), if it has one.
-    threshold: Option<f32>,
-    /// What a solver body is made of: mass (none for static colliders), whether the body
-    /// moves (has a velocity and is awake), and inertia.
-    mass: Option<Mass>,
-    moves: bool,
-    inertia: Option<Inertia>,
-}
-
-impl Side {
-    const UNSET: u32 = u32::MAX - 1;
-
-    fn new(body: bevy_ecs::query::ROQueryItem<'_, '_, PreparedBody>) -> Self {
-        let (
-            entity,
-            collider,
-            x,
-            q,
-            com,
-            mass,
-            v,
-            inertia,
-            w,
-            friction,
-            restitution,
-            threshold,
-            sleeping,
-        ) = body;
-        Side {
-            entity,
-            round: Roundness::of(collider.shape()),
-            index: Side::UNSET,
-            x: x.0,
-            q: q.0,
-            pose: shape_pose(x.0, q.0, com),
-            v: v.map_or(Vec3A::ZERO, |v| v.0),
-            w: w.map_or(Vec3A::ZERO, |w| w.0),
-            friction: friction.0,
-            restitution: restitution.0,
-            threshold: threshold.map(|t| t.0),
-            mass: mass.copied(),
-            moves: v.is_some() && !sleeping,
-            inertia: inertia.copied(),
-        }
-    }
-}
-
-/// How far a collider's contact points may be anchored inside it: the radius of a round
-/// shape (a ball, a capsule).
-///
-/// A round shape's support point in a direction does not turn with it: it is the centre of
-/// the ball (or of the capsule's cap) plus r times the direction. So its contact point is
-/// anchored there, r inside its surface along the normal: the normal passes through it, so
-/// the normal's effective mass and velocity are the same, and the separation the solver
-/// updates from the anchors (n·(Δx + ΔR r)) is not thrown off by the body's spin. Anchored
-/// on its surface, a ball spun by friction (a ball glancing off a wall at 70 m/s spins at
-/// 170 rad/s) read its gap as wider than it was and went through a thin wall.
-enum Roundness {
-    Round(f32),
-    /// A compound: its parts are looked up per manifold.
-    Parts(parry3d::shape::SharedShape),
-}
-
-impl Roundness {
-    fn of(shape: &parry3d::shape::SharedShape) -> Self {
-        if shape.shape_type() == parry3d::shape::ShapeType::Compound {
-            Roundness::Parts(shape.clone())
-        } else {
-            Roundness::Round(round_radius(&**shape))
-        }
-    }
-
-    /// The radius of the manifold's part (0 when it is not round).
-    fn radius(&self, part: u32) -> f32 {
-        match self {
-            Roundness::Round(r) => *r,
-            Roundness::Parts(shape) => shape
-                .as_compound()
-                .and_then(|c| c.shapes().get(part as usize))
-                .map_or(0.0, |(_, s)| round_radius(&**s)),
-        }
-    }
-}
-
-fn round_radius(shape: &dyn parry3d::shape::Shape) -> f32 {
-    use parry3d::shape::ShapeType;
-    // One virtual call for the common shapes; a downcast only for the round ones.
-    match shape.shape_type() {
-        ShapeType::Ball => shape.as_ball().map_or(0.0, |b| b.radius),
-        ShapeType::Capsule => shape.as_capsule().map_or(0.0, |c| c.radius),
-        _ => 0.0,
-    }
-}
-
-/// Solver index of a side's body, made on first use: a new [`SolverBody`] for anything
-/// with a velocity, [`FIXED`] for static colliders (whose velocities then read zero).
-fn body_index(solver: &mut ContactSolver, side: &mut Side) -> u32 {
-    if side.index == Side::UNSET {
-        side.index = new_body(solver, side);
-        if side.index == FIXED {
-            (side.v, side.w) = (Vec3A::ZERO, Vec3A::ZERO);
-        }
-    }
-    side.index
-}
-
-fn new_body(solver: &mut ContactSolver, side: &Side) -> u32 {
-    // A sleeping body holds still like a static one until its island wakes; a non-finite
-    // one (about to be quarantined) is kept out of the solver altogether.
-    let (Some(mass), true) = (side.mass, side.moves) else {
-        return FIXED;
-    };
-    let (x, q, v) = (side.x, side.q, side.v);
-    if !(x.is_finite() && v.is_finite() && q.is_finite()) {
-        return FIXED;
-    }
-    // A kinematic body drives its contacts but takes no impulse: zero inverse mass and
-    // inertia make every push on it exactly nothing.
-    let dynamic = !mass.is_pinned();
-    let (inv_i, i0) = match side.inertia {
-        Some(i) if dynamic && !i.is_infinite() => {
-            let (tensor, inverse) = i.world_tensors(q);
-            (inverse, tensor)
-        }
-        _ => (Mat3A::ZERO, Mat3A::ZERO),
-    };
-    let i = solver.bodies.len() as u32;
-    solver.bodies.push(SolverBody {
-        entity: side.entity,
-        inv_mass: if dynamic { mass.inverse() } else { 0.0 },
-        inv_i,
-        i0,
-        x0: x,
-        q0: q,
-        q_seen: q,
-        w_in: side.w,
-        dynamic,
-        isotropic: side.inertia.as_ref().is_some_and(Inertia::is_isotropic),
-    });
-    solver.index.insert(side.entity, i);
-    i
-}
-
-/// Friction directions for a manifold: the first along the sliding direction (the mean
-/// relative tangential velocity), or at rest along last step's friction impulse. With an
-/// arbitrary basis the per-point friction impulses of a face contact twist against each
-/// other through the body's rotation and their sum falls short of μN (measured: a box
-/// crept down a 30° slope at μ = 0.6).
-///
-/// `centre` is the mean of the solved points, where friction acts: the mean relative
-/// velocity of the points is the relative velocity at their mean (velocity is affine in
-/// position).
-fn tangent_basis(
-    n: Vec3A,
-    m: &super::narrow::Manifold,
-    centre: Vec3A,
-    (xa, va, wa): (Vec3A, Vec3A, Vec3A),
-    (xb, vb, wb): (Vec3A, Vec3A, Vec3A),
-) -> [Vec3A; 2] {
-    let slide = (vb + wb.cross(centre - xb)) - (va + wa.cross(centre - xa));
-    let impulse = Vec3A::from(m.data.tangent);
-    let normal: f32 = m.points.iter().map(|p| p.data.normal).sum();
-    let along = |v: Vec3A| (v - n * n.dot(v)).try_normalize();
-    // Only a clear signal picks the direction: below it (a body at rest under a small
-    // sideways load) a noisy direction would turn the basis from step to step, and a fixed
-    // basis is steadier.
-    let t0 = along(slide)
-        .filter(|_| slide.length() > 1e-2)
-        .or_else(|| along(impulse).filter(|_| impulse.length() > 0.05 * normal))
-        .unwrap_or_else(|| Vec3A::from(Vec3::from(n).any_orthonormal_pair().0));
-    [t0, n.cross(t0)]
-}
-
-#[allow(clippy::too_many_arguments)] // the step's inputs and its reused buffers
-fn prepare_contacts(
-    mut solver: ResMut<ContactSolver>,
-    mut active: ResMut<ConstraintsActive>,
-    contacts: Res<Contacts>,
-    bp: Res<BroadPhase>,
-    settings: Res<ContactSettings>,
-    bodies: Query<PreparedBody, (With<Collider>, Live)>,
-    mut buffers: Local<PrepareBuffers>,
-) {
-    let s = &mut *solver;
-    s.clear();
-    let touch = 0.25 * settings.margin;
-    let (wanted, pairs, sides) = &mut *buffers;
-    wanted.clear();
-    pairs.clear();
-    for &(ea, eb) in bp.pairs.iter().chain(&contacts.woken) {
-        let Some(state) = contacts.pairs.get(&(ea, eb)) else {
-            continue;
-        };
-        if state.sensor || state.solved().all(|m| m.points.is_empty()) {
-            continue;
-        }
-        pairs.push((ea, eb, wanted.slot(ea) as u32, wanted.slot(eb) as u32));
-    }
-    sides.clear();
-    sides.resize_with(wanted.len(), || None);
-    wanted.fetch(&bodies, |b| b.0, |i, b| sides[i] = Some(Side::new(b)));
-    for &(ea, eb, sa, sb) in pairs.iter() {
-        let Some(state) = contacts.pairs.get(&(ea, eb)) else {
-            continue;
-        };
-        let (sa, sb) = (sa as usize, sb as usize);
-        if sides[sa].is_none() || sides[sb].is_none() {
-            continue;
-        }
-        // Solver bodies are numbered in the order contacts first need them.
-        let ia = sides[sa].as_mut().map_or(FIXED, |a| body_index(s, a));
-        let ib = sides[sb].as_mut().map_or(FIXED, |b| body_index(s, b));
-        if ia == FIXED && ib == FIXED {
-            continue;
-        }
-        let (Some(a), Some(b)) = (&sides[sa], &sides[sb]) else {
-            continue;
-        };
-        let ((va, wa), (vb, wb)) = ((a.v, a.w), (b.v, b.w));
-        let (pose_a, pose_b) = (&a.pose, &b.pose);
-        let friction = settings.friction_rule.combine(a.friction, b.friction);
-        let restitution = settings
-            .restitution_rule
-            .combine(a.restitution, b.restitution);
-        // The lower of the two colliders' own thresholds, else the world's.
-        let threshold = match (a.threshold, b.threshold) {
-            (Some(x), Some(y)) => x.min(y),
-            (Some(x), None) | (None, Some(x)) => x,
-            (None, None) => settings.restitution_threshold,
-        };
-        for (mi, m) in state.solved().enumerate() {
-            if m.points.is_empty() {
-                continue;
-            }
-            // A compound's manifold is in its part's frame; the part's pose in the compound
-            // comes with the manifold.
-            let (pose_a, pose_b) = (
-                part_pose(pose_a, m.subshape_pos1()),
-                part_pose(pose_b, m.subshape_pos2()),
-            );
-            let n = Vec3A::from(pose_a.rotation * m.local_n1);
-            let first = s.inputs.len() as u32;
-            let kept = m.data.kept();
-            let count = kept.len();
-            let mut mids = [Vec3A::ZERO; super::narrow::MAX_POINTS];
-            let mut witness = [(Vec3A::ZERO, Vec3A::ZERO); super::narrow::MAX_POINTS];
-            for ((mid, w), &k) in mids.iter_mut().zip(&mut witness).zip(kept) {
-                let p = &m.points[usize::from(k)];
-                *w = (
-                    Vec3A::from(pose_a * p.local_p1),
-                    Vec3A::from(pose_b * p.local_p2),
-                );
-                *mid = 0.5 * (w.0 + w.1);
-            }
-            // A round side's points are anchored at its centre of curvature (see
-            // `Roundness`).
-            let (round_a, round_b) = (a.round.radius(m.subshape1), b.round.radius(m.subshape2));
-            let mids = &mids[..count];
-            // Friction acts at the kept points' centre; the twist's arm is their mean
-            // distance from it.
-            let middle = mids.iter().sum::<Vec3A>() / count as f32;
-            let t = tangent_basis(n, m, middle, (a.x, va, wa), (b.x, vb, wb));
-            let radius = mids.iter().map(|&p| (p - middle).length()).sum::<f32>() / count as f32;
-            for ((&k, &mid), &(w_a, w_b)) in kept.iter().zip(mids).zip(&witness) {
-                let p = &m.points[usize::from(k)];
-                // A touching point acts at the middle of its two witness points. A
-                // speculative one, with a gap still open, acts on each body where that body
-                // will touch: anchored in the gap, its lever arms were as long as the gap
-                // (metres for a fast body), and friction on them spun the body.
-                let (p_a, p_b) = if p.dist > touch {
-                    (w_a, w_b)
-                } else {
-                    (mid, mid)
-                };
-                let p_a = if round_a > 0.0 {
-                    w_a - n * round_a
-                } else {
-                    p_a
-                };
-                let p_b = if round_b > 0.0 {
-                    w_b + n * round_b
-                } else {
-                    p_b
-                };
-                let (r_a, r_b) = (p_a - a.x, p_b - b.x);
-                let rel = (vb + wb.cross(r_b)) - (va + wa.cross(r_a));
-                s.inputs.push(PointInput {
-                    r_a,
-                    r_b,
-                    base: p.dist - n.dot(r_b - r_a),
-                    n_imp: p.data.normal,
-                    approach: n.dot(rel),
-                    source: u32::from(k),
-                });
-            }
-            let tangent = Vec3A::from(m.data.tangent);
-            s.manifolds.push(ManifoldConstraint {
-                a: ia,
-                b: ib,
-                n,
-                t,
-                friction,
-                restitution,
-                threshold,
-                first,
-                count: s.inputs.len() as u32 - first,
-                pair: (ea, eb),
-                manifold: mi as u32,
-                centre_a: middle - a.x,
-                centre_b: middle - b.x,
-                radius,
-                t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
-                twist: m.data.twist,
-            });
-        }
-    }
-    s.build();
-    active.0 = !s.manifolds.is_empty();
 }
 
 fn softness(settings: &ContactSettings, h: f32) -> (Softness, Softness) {
