@@ -40,7 +40,11 @@
 //! when they spin), which adds the impact's normal when the closest features at the start
 //! of the step miss it (see the `ccd` module). A body in contact turns at most
 //! [`ContactSettings::max_rotation`] per substep, since contact lever arms are set at the
-//! start of the step.
+//! start of the step. A body that overlaps something deeply (more than a quarter of the
+//! thinner shape) leaves each contact pass no faster than it entered the substep or than
+//! [`ContactSettings::max_push_velocity`], and in such a step the contacts with static
+//! bodies are solved once more after each pass: a heap spawned at one point spreads out on
+//! the ground instead of exploding through it.
 //!
 //! **Bodies.** A [`Collider`] on a body with a finite [`crate::Mass`] is dynamic; on a pinned
 //! or massless entity it is static (a kinematic body's velocity still drives its contacts).

@@ -521,9 +521,12 @@ fn solve_contacts(
 ) {
     gather(&mut solver, &bodies);
     solver.limit_rotation(settings.max_rotation / time.h);
+    solver.record_speeds();
     let (soft, fixed) = softness(&settings, time.h);
     solver.warm_start();
     solver.solve(time.h, soft, fixed, true, settings.max_push_velocity);
+    solver.solve_grounded(time.h, soft, fixed, true, settings.max_push_velocity);
+    solver.limit_deep_speed(settings.max_push_velocity);
     scatter(&mut solver, &mut bodies);
 }
 
@@ -539,8 +542,12 @@ fn relax_contacts(
     gather(&mut solver, &bodies);
     let (soft, fixed) = softness(&settings, time.h);
     solver.solve(time.h, soft, fixed, false, settings.max_push_velocity);
+    solver.solve_grounded(time.h, soft, fixed, false, settings.max_push_velocity);
     if time.is_last() {
         solver.restitution();
+    }
+    solver.limit_deep_speed(settings.max_push_velocity);
+    if time.is_last() {
         for solved in solver.manifold_impulses() {
             let m = solved.constraint;
             let Some(tracked) = contacts

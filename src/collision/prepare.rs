@@ -51,6 +51,8 @@ pub(super) struct Side {
     w: Vec3A,
     /// What the anchors of its contact points need of its shape.
     round: Roundness,
+    /// How thin its shape is (m; see `ccd::thickness`).
+    thin: f32,
     friction: f32,
     restitution: f32,
     /// The collider's own restitution threshold (m/s), if it has one.
@@ -84,6 +86,7 @@ impl Side {
         Side {
             entity,
             round: Roundness::of(collider.shape()),
+            thin: super::ccd::thickness(collider.local_bounds()),
             index: Side::UNSET,
             x: x.0,
             q: q.0,
@@ -191,6 +194,8 @@ fn new_body(solver: &mut ContactSolver, side: &Side) -> u32 {
         w_in: side.w,
         dynamic,
         isotropic: side.inertia.as_ref().is_some_and(Inertia::is_isotropic),
+        deep: false,
+        speed_in: 0.0,
     });
     solver.index.insert(side.entity, i);
     i
@@ -347,6 +352,19 @@ pub(super) fn prepare_contacts(
                     approach: n.dot(rel),
                     source: u32::from(k),
                 });
+            }
+            // An overlap deeper than a quarter of the thinner shape marks both bodies (see
+            // `ContactSolver::limit_deep_speed`).
+            let deepest = kept
+                .iter()
+                .map(|&k| m.points[usize::from(k)].dist)
+                .fold(f32::INFINITY, f32::min);
+            if -deepest > 0.25 * a.thin.min(b.thin).max(settings.margin) {
+                for i in [ia, ib] {
+                    if let Some(body) = s.bodies.get_mut(i as usize) {
+                        body.deep = true;
+                    }
+                }
             }
             let tangent = Vec3A::from(m.data.tangent);
             s.manifolds.push(ManifoldConstraint {
