@@ -50,7 +50,7 @@ pub(crate) struct PairState {
     pub recycle: Option<Recycle>,
     /// This step's time-of-impact manifold for a fast pair (see the `ccd` module): solved
     /// after `manifolds`, found anew every step, never warm-started.
-    pub cast: Option<Manifold>,
+    pub cast: Option<Box<Manifold>>,
 }
 
 /// The relative pose and reach of a pair's last full manifold update.
@@ -102,7 +102,7 @@ impl PairState {
 
     /// The manifolds the solver takes: parry's, then the time-of-impact one.
     pub fn solved(&self) -> impl Iterator<Item = &Manifold> {
-        self.manifolds.iter().chain(&self.cast)
+        self.manifolds.iter().chain(self.cast.as_deref())
     }
 }
 

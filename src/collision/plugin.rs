@@ -392,6 +392,7 @@ fn update_contacts(
         let state = contacts.pairs.entry((a, b)).or_insert_with(PairState::new);
         state.seen = step;
         state.sensor = sensor;
+        // Boxed: the pair map holds every pair inline, and few are ever cast.
         state.cast = None;
         let touching = if sensor {
             let (sa, sb) = (&**ca.collider.shape(), &**cb.collider.shape());
@@ -444,7 +445,8 @@ fn update_contacts(
                     thin,
                     &state.manifolds,
                     scratch,
-                );
+                )
+                .map(Box::new);
             }
             state
                 .manifolds
