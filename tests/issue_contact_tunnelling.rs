@@ -157,3 +157,38 @@ fn a_ball_shot_at_a_wall_stops_on_its_near_face_and_slides_along_it() {
     assert!(v.x.abs() < 0.5, "{v}");
     assert!((v.y - 300.0 * a.sin()).abs() < 1.0, "{v}");
 }
+
+/// The casts see whatever speed a body has for the one step before the divergence guard
+/// takes it out: absurd speeds and spins near a wall must not panic inside parry, and the
+/// body must end quarantined while the wall stays put.
+#[test]
+fn absurd_speeds_near_a_wall_are_quarantined_without_a_panic() {
+    let shapes: [fn() -> Collider; 3] = [
+        || Collider::ball(0.05).unwrap(),
+        || Collider::cuboid(0.05, 0.05, 0.05).unwrap(),
+        || Collider::capsule_y(0.05, 0.03).unwrap(),
+    ];
+    for speed in [1e5f32, 1e20, 1e30, f32::MAX] {
+        for spin in [0.0f32, 1e6, 1e30] {
+            for shape in shapes {
+                let mut w = world_with_wall(10.0);
+                let body = w
+                    .spawn((
+                        RigidBody::Dynamic,
+                        shape(),
+                        Position::from(Vec3::new(-1.0, 0.0, 0.0)),
+                        LinearVelocity::from(Vec3::new(speed, 0.3 * speed, 0.0)),
+                        AngularVelocity::from(Vec3::new(spin, 0.0, spin)),
+                    ))
+                    .id();
+                for _ in 0..5 {
+                    w.step_physics();
+                }
+                assert!(
+                    w.get::<Quarantined>(body).is_some(),
+                    "{speed} m/s, {spin} rad/s: not quarantined"
+                );
+            }
+        }
+    }
+}
