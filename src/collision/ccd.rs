@@ -40,6 +40,14 @@ pub(crate) fn thickness(bounds: [Vec3; 2]) -> f32 {
     (bounds[1] - bounds[0]).min_element().max(0.0)
 }
 
+/// The thickness a pair is judged by (m): the thinner of the two, at least `margin` (a
+/// triangle mesh or heightfield is zero thick, and every pair moving on one at all would
+/// otherwise count as fast or deep).
+#[must_use]
+pub(crate) fn pair_thickness(a: f32, b: f32, margin: f32) -> f32 {
+    a.min(b).max(margin)
+}
+
 /// True when a pair moves far enough against itself in one step to be cast: `sweep`, its
 /// relative speed plus the larger of its sides' spin speeds |ω| r (m/s), carries it past a
 /// quarter of `thin` in `dt`.
@@ -59,8 +67,8 @@ pub(crate) struct CastSide<'a> {
     pub spin: Vec3,
     /// The centre of mass in the shape's frame (m).
     pub centre: Vec3,
-    /// How far the shape reaches from its centre of mass (m).
-    pub radius: f32,
+    /// The fastest speed its spin gives any of its points, |ω| r (m/s).
+    pub swing: f32,
 }
 
 impl CastSide<'_> {
@@ -98,7 +106,7 @@ pub(crate) fn impact_manifold(
         .ok()
         .flatten()
     };
-    let spun = (a.spin.length() * a.radius).max(b.spin.length() * b.radius) * dt > 0.25 * thin;
+    let spun = is_fast(a.swing.max(b.swing), dt, thin);
     let hit = if spun {
         match parry3d::query::cast_shapes_nonlinear(
             &a.motion(),

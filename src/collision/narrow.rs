@@ -49,7 +49,8 @@ pub(crate) struct PairState {
     /// Where the last full update ran, while its manifolds may be reused.
     pub recycle: Option<Recycle>,
     /// This step's time-of-impact manifold for a fast pair (see the `ccd` module): solved
-    /// after `manifolds`, found anew every step, never warm-started.
+    /// after `manifolds`, found anew every step, never warm-started. Boxed: the pair map
+    /// holds every pair inline, and few are ever cast.
     pub cast: Option<Box<Manifold>>,
 }
 

@@ -291,9 +291,8 @@ struct NarrowBody<'a> {
     velocity: Vec3,
     /// Angular velocity (rad/s; zero for static colliders).
     spin: Vec3,
-    /// Centre of mass in the shape's frame (m) and how far the shape reaches from it.
+    /// Centre of mass in the shape's frame (m).
     centre: Vec3,
-    radius: f32,
     /// The fastest speed its spin gives any of its points, |ω| r (m/s).
     swing: f32,
     /// How thin the shape is (m; see [`super::ccd::thickness`]).
@@ -315,7 +314,7 @@ impl<'a> NarrowBody<'a> {
             velocity: self.velocity,
             spin: self.spin,
             centre: self.centre,
-            radius: self.radius,
+            swing: self.swing,
         }
     }
 }
@@ -335,7 +334,6 @@ fn narrow_body<'a>(
         velocity: v.map_or(Vec3::ZERO, |v| v.0.into()),
         spin: w.map_or(Vec3::ZERO, |w| w.0.into()),
         centre: com.map_or(Vec3::ZERO, |c| c.0),
-        radius: reach,
         swing,
         thin: super::ccd::thickness([lo, hi]),
         speed,
@@ -392,7 +390,6 @@ fn update_contacts(
         let state = contacts.pairs.entry((a, b)).or_insert_with(PairState::new);
         state.seen = step;
         state.sensor = sensor;
-        // Boxed: the pair map holds every pair inline, and few are ever cast.
         state.cast = None;
         let touching = if sensor {
             let (sa, sb) = (&**ca.collider.shape(), &**cb.collider.shape());
@@ -433,9 +430,7 @@ fn update_contacts(
                     }
                 }
             }
-            // A triangle mesh or heightfield is zero thick: without the margin as a floor,
-            // every pair moving on one at all would be cast every step.
-            let thin = ca.thin.min(cb.thin).max(settings.margin);
+            let thin = super::ccd::pair_thickness(ca.thin, cb.thin, settings.margin);
             let sweep = (cb.velocity - ca.velocity).length() + ca.swing.max(cb.swing);
             if super::ccd::is_fast(sweep, dt, thin) {
                 state.cast = super::ccd::impact_manifold(

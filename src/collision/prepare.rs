@@ -359,7 +359,7 @@ pub(super) fn prepare_contacts(
                 .iter()
                 .map(|&k| m.points[usize::from(k)].dist)
                 .fold(f32::INFINITY, f32::min);
-            if -deepest > 0.25 * a.thin.min(b.thin).max(settings.margin) {
+            if -deepest > 0.25 * super::ccd::pair_thickness(a.thin, b.thin, settings.margin) {
                 for i in [ia, ib] {
                     if let Some(body) = s.bodies.get_mut(i as usize) {
                         body.deep = true;
