@@ -138,6 +138,7 @@
 
 #![warn(missing_docs)]
 
+pub mod accuracy;
 #[cfg(feature = "bevy")]
 pub mod bevy;
 pub mod cloth;
