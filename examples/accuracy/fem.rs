@@ -1,0 +1,119 @@
+//! The FEM cantilever: strain model × mesh against beam theory, each a static solve.
+
+use std::time::Instant;
+
+use bevy_ecs::prelude::*;
+use glam::{Vec3, Vec3A};
+use hooke::ImplicitEuler;
+use hooke::accuracy::{Measurement, Setting, SweepReport, world_for};
+use hooke::prelude::*;
+use hooke::schedule::{ForceSystems, add_force_systems};
+use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+
+use crate::problems::Problem;
+
+#[derive(Resource)]
+struct TipLoad(Entity, Vec<usize>, f32);
+
+fn apply_tip_load(load: Res<TipLoad>, mut meshes: Query<&mut Nodes>) {
+    let Ok(mut n) = meshes.get_mut(load.0) else {
+        return;
+    };
+    let each = Vec3A::new(0.0, -load.2 / load.1.len() as f32, 0.0);
+    for &i in &load.1 {
+        let _ = n.add_force(i, each);
+    }
+}
+
+/// Tip deflection (m) of a 1 m × 0.1 m × 0.1 m cantilever (E = 1e8 Pa, ν = 0) under a 10 N tip
+/// load, from one backward-Euler step of 100 s (M/h² vanishes beside K: a static solve), and
+/// the solve's time (s).
+fn deflection(cells: [usize; 3], model: StrainModel) -> hooke::Result<(f64, f64)> {
+    let mut w = world_for(Setting::new(Integrator::SymplecticEuler, 1), 100.0)?;
+    w.insert_resource(Gravity::new(Vec3::ZERO)?);
+    let material = Material::new(1e8, 0.0, 1000.0)?;
+    let mesh = TetMesh::cuboid(Vec3::new(1.0, 0.1, 0.1), cells, CellSplit::Six)?;
+    let (mut nodes, body) = SoftBody::build(&mesh, Vec3::new(0.5, 0.0, 0.0), material, model)?;
+    for i in 0..nodes.len() {
+        if nodes.positions()[i].x.abs() < 1e-5 {
+            nodes.pin(i)?;
+        }
+    }
+    let tip: Vec<usize> = (0..nodes.len())
+        .filter(|&i| (nodes.positions()[i].x - 1.0).abs() < 1e-5)
+        .collect();
+    let settings = ImplicitEuler {
+        tolerance: 1e-6,
+        max_newton: 20,
+        max_cg: 5000,
+        ..ImplicitEuler::default()
+    };
+    let e = w.spawn((nodes, body, settings)).id();
+    w.insert_resource(TipLoad(e, tip.clone(), 10.0));
+    add_force_systems(&mut w, || apply_tip_load.in_set(ForceSystems::User));
+    let t0 = Instant::now();
+    w.step_physics();
+    let spent = t0.elapsed().as_secs_f64();
+    if w.get::<Quarantined>(e).is_some() {
+        return Ok((f64::NAN, spent));
+    }
+    let n = w.get::<Nodes>(e).expect("the beam was spawned");
+    let dy: f32 = tip.iter().map(|&i| n.positions()[i].y).sum::<f32>() / tip.len() as f32;
+    Ok((-f64::from(dy), spent))
+}
+
+pub fn cantilever(quick: bool) -> hooke::Result<Problem> {
+    // F L³ / (3 E I) with I = a⁴/12.
+    let closed = 10.0 * 1.0 / (3.0 * 1e8 * 0.1f64.powi(4) / 12.0);
+    let meshes: &[[usize; 3]] = if quick {
+        &[[10, 1, 1], [20, 2, 2]]
+    } else {
+        &[[10, 1, 1], [20, 2, 2], [40, 4, 4]]
+    };
+    let models = [
+        StrainModel::Green,
+        StrainModel::Cauchy,
+        StrainModel::Corotated,
+        StrainModel::StableNeoHookean,
+    ];
+    let (mut measurements, mut names) = (Vec::new(), Vec::new());
+    for model in models {
+        for &cells in meshes {
+            let mut times = Vec::new();
+            let mut tip = 0.0;
+            for _ in 0..if quick { 1 } else { 3 } {
+                let (d, t) = deflection(cells, model)?;
+                tip = d;
+                times.push(t);
+            }
+            times.sort_by(f64::total_cmp);
+            let error = (tip - closed).abs();
+            measurements.push(Measurement {
+                setting: Setting::new(Integrator::ImplicitEuler, 1),
+                error: if error.is_finite() {
+                    error
+                } else {
+                    f64::INFINITY
+                },
+                seconds_per_step: times[times.len() / 2],
+                quarantined: false,
+            });
+            names.push((
+                format!("{model:?}"),
+                format!("{}×{}×{}", cells[0], cells[1], cells[2]),
+            ));
+        }
+    }
+    let mut p = Problem::new(
+        "FEM cantilever, static tip load (E = 1e8)",
+        "|tip deflection − F L³/(3EI)| per 4.000 mm; time of the static solve",
+        "closed form (Euler–Bernoulli); linear tets lock, so error falls with the mesh",
+        closed,
+        SweepReport {
+            measurements,
+            reference_seconds_per_step: None,
+        },
+    );
+    p.names = Some(names);
+    Ok(p)
+}
