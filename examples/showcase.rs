@@ -1,6 +1,7 @@
 //! The README demo: a swinging rope, a hair strand, tracers in a vortex and thrown
 //! particles, stepped headless for 5 s. Prints one summary line per simulated second and
-//! writes `out/showcase.png` (trajectories and rope snapshots).
+//! writes `out/showcase.png` (trajectories and rope snapshots, with axes in metres and a
+//! legend).
 //!
 //! ```text
 //! cargo run --release --example showcase
@@ -8,12 +9,11 @@
 
 mod common;
 
-use std::path::Path;
-
 use bevy_ecs::prelude::*;
-use common::{Canvas, ramp};
+use common::{ramp, register_fonts};
 use hooke::prelude::*;
 use hooke::scenes;
+use plotters::prelude::*;
 
 fn xy(world: &World, e: Entity) -> (f32, f32) {
     let p = world.get::<Position>(e).map_or(Vec3::NAN, Position::get);
@@ -30,9 +30,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
     let scene = scenes::showcase(&mut world)?;
 
-    let mut canvas = Canvas::new(1100, 700, [-5.0, -3.0, 6.0, 4.0], [250, 250, 248]);
     let mut particle_paths: Vec<Vec<(f32, f32)>> = vec![Vec::new(); scene.particles.len()];
     let mut tracer_paths: Vec<Vec<(f32, f32)>> = vec![Vec::new(); scene.tracers.len()];
+    // (time fraction, rope, hair) every half second.
+    let mut snapshots = Vec::new();
     let seconds = 5;
     println!(
         "{:>5} {:>10} {:>10} {:>10} {:>10} {:>10}  counts",
@@ -49,12 +50,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             path.push(xy(&world, e));
         }
         if step % 30 == 0 {
-            // A snapshot of the rope and the hair every half second, blue to orange.
             let t = step as f32 / (seconds * 60) as f32;
             let rope: Vec<_> = scene.rope.nodes.iter().map(|&e| xy(&world, e)).collect();
             let hair: Vec<_> = scene.hair.nodes.iter().map(|&e| xy(&world, e)).collect();
-            canvas.polyline(&rope, 2, ramp(t));
-            canvas.polyline(&hair, 1, ramp(t));
+            snapshots.push((t, rope, hair));
         }
         if step > 0 && step % 60 == 0 {
             let d = world.resource::<PhysicsDiagnostics>();
@@ -74,27 +73,85 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             );
         }
     }
-    for path in &tracer_paths {
-        canvas.polyline(path, 1, [120, 170, 120]);
+
+    register_fonts()?;
+    let path = "out/showcase.png";
+    std::fs::create_dir_all("out")?;
+    let root = BitMapBackend::new(path, (1100, 760)).into_drawing_area();
+    root.fill(&RGBColor(252, 252, 250))?;
+    let mut chart = ChartBuilder::on(&root)
+        .caption(
+            "hooke showcase: 5 s at 60 Hz (rope and hair snapshots every 0.5 s, blue → orange)",
+            ("sans-serif", 20),
+        )
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(50)
+        .build_cartesian_2d(-5.0f32..6.0, -3.0f32..4.0)?;
+    chart
+        .configure_mesh()
+        .x_desc("x (m)")
+        .y_desc("y (m)")
+        .label_style(("sans-serif", 13))
+        .light_line_style(WHITE)
+        .draw()?;
+    chart
+        .draw_series(LineSeries::new(
+            [(-5.0, 0.0), (6.0, 0.0)],
+            RGBColor(160, 160, 160),
+        ))?
+        .label("y = 0")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], RGBColor(160, 160, 160)));
+    let tracer = RGBColor(120, 170, 120);
+    for (i, p) in tracer_paths.iter().enumerate() {
+        let s = chart.draw_series(LineSeries::new(p.iter().copied(), tracer))?;
+        if i == 0 {
+            s.label("tracers carried by the vortex field")
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], tracer));
+        }
     }
-    for path in &particle_paths {
-        canvas.polyline(path, 2, [200, 60, 60]);
+    for (t, rope, hair) in &snapshots {
+        let c = ramp(*t);
+        chart.draw_series(LineSeries::new(rope.iter().copied(), c.stroke_width(2)))?;
+        chart.draw_series(LineSeries::new(hair.iter().copied(), c.stroke_width(1)))?;
     }
-    for &e in &scene.particles {
-        let (x, y) = xy(&world, e);
-        canvas.dot(x, y, 4, [150, 20, 20]);
+    // Legend entries for the snapshots: the first and last colours.
+    chart
+        .draw_series(std::iter::empty::<Circle<(f32, f32), i32>>())?
+        .label("rope (thick) and hair (thin) at t = 0 s")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], ramp(0.0).stroke_width(2)));
+    chart
+        .draw_series(std::iter::empty::<Circle<(f32, f32), i32>>())?
+        .label("… at t = 5 s")
+        .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], ramp(1.0).stroke_width(2)));
+    let red = RGBColor(200, 60, 60);
+    // Each path up to where it leaves the view (plotters would pin it to the border).
+    let inside = |&(x, y): &(f32, f32)| (-5.0..=6.0).contains(&x) && (-3.0..=4.0).contains(&y);
+    for (i, p) in particle_paths.iter().enumerate() {
+        let shown = p.iter().copied().take_while(inside);
+        let s = chart.draw_series(LineSeries::new(shown, red.stroke_width(2)))?;
+        if i == 0 {
+            s.label("thrown particles' paths (no ground: they fall through y = 0)")
+                .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], red.stroke_width(2)));
+        }
     }
-    // Ground line at y = 0 and the rope's anchor.
-    canvas.line((-5.0, 0.0), (6.0, 0.0), 1, [180, 180, 180]);
-    let (ax, ay) = xy(&world, scene.rope.nodes[0]);
-    canvas.dot(ax, ay, 5, [0, 0, 0]);
-    let path = Path::new("out/showcase.png");
-    canvas.save_png(path)?;
+    chart
+        .draw_series(std::iter::once(Circle::new(
+            xy(&world, scene.rope.nodes[0]),
+            5,
+            BLACK.filled(),
+        )))?
+        .label("rope anchor (pinned)")
+        .legend(|(x, y)| Circle::new((x + 9, y), 4, BLACK.filled()));
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperRight)
+        .label_font(("sans-serif", 13))
+        .background_style(WHITE.mix(0.9))
+        .border_style(BLACK)
+        .draw()?;
+    root.present()?;
     let d = world.resource::<PhysicsDiagnostics>();
-    println!(
-        "wrote {} (rope and hair snapshots blue→orange every 0.5 s, particle paths red, tracers green); last step {:?}",
-        path.display(),
-        d.step_time
-    );
+    println!("wrote {path}; last step {:?}", d.step_time);
     Ok(())
 }

@@ -6,7 +6,7 @@ use plotters::prelude::*;
 
 use crate::problems::Problem;
 
-const SERIES: [(&str, RGBColor); 9] = [
+const SERIES: [(&str, RGBColor); 12] = [
     ("explicit_euler", RGBColor(214, 39, 40)),
     ("symplectic_euler", RGBColor(31, 119, 180)),
     ("velocity_verlet", RGBColor(44, 160, 44)),
@@ -16,6 +16,9 @@ const SERIES: [(&str, RGBColor); 9] = [
     ("Cauchy", RGBColor(188, 189, 34)),
     ("Corotated", RGBColor(140, 86, 75)),
     ("StableNeoHookean", RGBColor(227, 119, 194)),
+    ("Splitting", RGBColor(0, 128, 128)),
+    ("ExpMap", RGBColor(127, 127, 127)),
+    ("FirstOrder", RGBColor(0, 0, 0)),
 ];
 
 /// The 1 %, 0.1 % and 0.01 % lines.
@@ -145,52 +148,54 @@ fn panel<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, p: &Problem) -> Draw
 
 fn legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>) -> DrawResult {
     let font = ("sans-serif", 14).into_font();
-    let mut y = 20;
     area.draw(&Text::new(
         "Legend",
-        (20, y),
+        (20, 16),
         ("sans-serif", 16).into_font(),
     ))
     .map_err(err)?;
-    y += 26;
+    // Left column: the marker series.
+    let mut y = 42;
     for (name, c) in SERIES {
         area.draw(&Circle::new((28, y + 7), 5, c.filled()))
             .map_err(err)?;
         area.draw(&Text::new(name, (42, y), font.clone()))
             .map_err(err)?;
-        y += 22;
+        y += 20;
     }
+    // Right column: the lines and how to read the labels.
+    let (x, mut y) = (200, 42);
     area.draw(&PathElement::new(
-        vec![(20, y + 7), (38, y + 7)],
+        vec![(x, y + 7), (x + 18, y + 7)],
         BLACK.stroke_width(2),
     ))
     .map_err(err)?;
-    area.draw(&Text::new(
-        "Pareto front (cheapest for its error)",
-        (42, y),
-        font.clone(),
-    ))
-    .map_err(err)?;
-    y += 22;
+    area.draw(&Text::new("Pareto front", (x + 24, y), font.clone()))
+        .map_err(err)?;
+    y += 20;
     area.draw(&PathElement::new(
-        vec![(20, y + 7), (38, y + 7)],
+        vec![(x, y + 7), (x + 18, y + 7)],
         TOLERANCE.stroke_width(1),
     ))
     .map_err(err)?;
-    area.draw(&Text::new(
-        "1 %, 0.1 %, 0.01 % error (top to bottom)",
-        (42, y),
-        font.clone(),
-    ))
-    .map_err(err)?;
-    y += 26;
+    area.draw(&Text::new("1 %, 0.1 %, 0.01 %", (x + 24, y), font.clone()))
+        .map_err(err)?;
+    y += 30;
     for line in [
-        "Labels: substeps per step (×1 … ×8);",
-        "FEM panel: mesh cells, static solve.",
-        "Integrator colours: Verlet and RK4 re-run",
-        "the forces 2 and 4 times per substep.",
+        "Pareto front: the cheapest",
+        "setting for its error.",
+        "Labels: substeps per step",
+        "(×1 … ×8).",
+        "FEM panel: mesh cells;",
+        "time of one static solve.",
+        "Orientation panel:",
+        "SE symplectic Euler,",
+        "VV velocity Verlet;",
+        "Splitting is the default.",
+        "Diverged settings are",
+        "counted in the panel title.",
     ] {
-        area.draw(&Text::new(line, (20, y), ("sans-serif", 12).into_font()))
+        area.draw(&Text::new(line, (x, y), ("sans-serif", 12).into_font()))
             .map_err(err)?;
         y += 17;
     }

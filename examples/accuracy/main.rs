@@ -31,12 +31,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let quick = std::env::args().any(|a| a == "--quick");
     let start = Instant::now();
     type Build = fn(bool) -> hooke::Result<Problem>;
-    let all: [(&str, Build); 11] = [
+    let all: [(&str, Build); 12] = [
         ("oscillator", problems::oscillator),
         ("damped", problems::damped_oscillator),
         ("pendulum", problems::pendulum),
         ("kepler", problems::kepler),
         ("torque-free", problems::torque_free),
+        ("orientation", problems::orientation_updates),
         ("chain", problems::stiff_chain),
         ("catenary", problems::catenary),
         ("bounce", problems::bouncing_ball),
@@ -61,7 +62,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::write("out/accuracy.md", &md)?;
     register_font("sans-serif", FontStyle::Normal, FONT)
         .map_err(|_| "the bundled font did not load")?;
-    let size = (1920, 1240);
+    let size = (1920, 1560);
     chart::draw(
         &BitMapBackend::new(Path::new("out/accuracy.png"), size).into_drawing_area(),
         &done,
@@ -106,16 +107,17 @@ fn table(problems: &[Problem]) -> String {
             None => "none swept".into(),
         };
         let default = if p.names.is_some() {
-            "— (static solve)".to_string()
+            p.default.map(|i| &p.report.measurements[i])
         } else {
-            p.report.get(Setting::DEFAULT).map_or("—".into(), |m| {
-                format!(
-                    "{} in {:.1} µs",
-                    percent(p.relative(m)),
-                    m.seconds_per_step * 1e6
-                )
-            })
+            p.report.get(Setting::DEFAULT)
         };
+        let default = default.map_or("— (a static solve: no such setting)".into(), |m| {
+            format!(
+                "{} in {:.1} µs",
+                percent(p.relative(m)),
+                m.seconds_per_step * 1e6
+            )
+        });
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} |",

@@ -6,8 +6,8 @@ use hooke::accuracy::{Measurement, Reference, Setting, Sweep, SweepReport, sweep
 use hooke::prelude::*;
 use hooke::schedule::{ForceSystems, add_force_systems};
 use hooke::{
-    Collider, Friction, Inertia, MassProperties, Restitution, RigidBodyBundle, Rotation,
-    StabilityPolicy, scenes,
+    Collider, Friction, Inertia, MassProperties, OrientationUpdate, Restitution, RigidBodyBundle,
+    Rotation, StabilityPolicy, scenes,
 };
 
 /// One problem's sweep, with how its error is measured.
@@ -22,6 +22,8 @@ pub struct Problem {
     /// Series and label per measurement, when they are not the integrator and substeps
     /// (the FEM cantilever: strain model and mesh).
     pub names: Option<Vec<(String, String)>>,
+    /// With `names`: which measurement is hooke's default setting, if any is.
+    pub default: Option<usize>,
 }
 
 impl Problem {
@@ -39,6 +41,7 @@ impl Problem {
             scale,
             report,
             names: None,
+            default: None,
         }
     }
 
@@ -77,7 +80,7 @@ pub fn settings() -> Vec<Setting> {
 }
 
 fn runs(quick: bool) -> u32 {
-    if quick { 1 } else { 3 }
+    if quick { 1 } else { 7 }
 }
 
 /// The world every problem starts from: gravity `g`, sleeping off (a resting body would stop
@@ -326,7 +329,12 @@ fn axes(x: f64, y: f64, z: f64, w: f64) -> Vec<f64> {
         .collect()
 }
 
-pub fn torque_free(quick: bool) -> hooke::Result<Problem> {
+/// The torque-free body swept at `settings` with orientation update `update`.
+fn tumbler_sweep(
+    update: OrientationUpdate,
+    settings: &[Setting],
+    quick: bool,
+) -> hooke::Result<SweepReport> {
     // I = diag(1, 2, 3), spun mostly about the major axis: a stable, nutating tumble.
     let omega0 = DVec3::new(0.4, 0.2, 3.0);
     let sweep_cfg = Sweep::seconds(5.0).with_timing_runs(runs(quick));
@@ -336,9 +344,10 @@ pub fn torque_free(quick: bool) -> hooke::Result<Problem> {
         f64::from(sweep_cfg.dt),
         sweep_cfg.steps,
     );
-    let report = sweep(
+    sweep(
         move |w: &mut World| {
             base(w, Vec3::ZERO)?;
+            w.insert_resource(update);
             let props = MassProperties::new(1.0, Vec3::ZERO, Inertia::diagonal(1.0, 2.0, 3.0)?)?;
             w.spawn((
                 RigidBodyBundle::dynamic(props)?.with_angular_velocity(omega0.as_vec3())?,
@@ -357,20 +366,70 @@ pub fn torque_free(quick: bool) -> hooke::Result<Problem> {
             );
             v.into_iter().map(|x| x as f32).collect()
         },
-        &settings(),
+        settings,
         Reference::exact(move |t| {
             let i = ((t * 60.0).round() as usize).clamp(1, reference.len());
             reference[i - 1].clone()
         }),
         sweep_cfg,
-    )?;
+    )
+}
+
+const TUMBLER: &str = "max error of the body's x and y axes over 5 s (unit vectors: about radians)";
+const TUMBLER_REFERENCE: &str = "converged f64 RK4 of the quaternion ODE";
+
+pub fn torque_free(quick: bool) -> hooke::Result<Problem> {
+    let report = tumbler_sweep(OrientationUpdate::default(), &settings(), quick)?;
     Ok(Problem::new(
         "torque-free body, I = diag(1, 2, 3)",
-        "max error of the body's x and y axes over 5 s (orientation, rad-like)",
-        "converged f64 RK4 of the quaternion ODE",
+        TUMBLER,
+        TUMBLER_REFERENCE,
         1.0,
         report,
     ))
+}
+
+/// The same body under each orientation update, with the two integrators that use them
+/// differently (Lie–Trotter for symplectic Euler, Strang for Verlet).
+pub fn orientation_updates(quick: bool) -> hooke::Result<Problem> {
+    let settings = Setting::grid(
+        &[Integrator::SymplecticEuler, Integrator::VelocityVerlet],
+        &[1, 2, 4, 8],
+    );
+    let (mut measurements, mut names) = (Vec::new(), Vec::new());
+    for update in [
+        OrientationUpdate::Splitting,
+        OrientationUpdate::ExpMap,
+        OrientationUpdate::FirstOrder,
+    ] {
+        let report = tumbler_sweep(update, &settings, quick)?;
+        for m in report.measurements {
+            let short = match m.setting.integrator {
+                Integrator::SymplecticEuler => "SE",
+                _ => "VV",
+            };
+            names.push((
+                format!("{update:?}"),
+                format!("{short}×{}", m.setting.substeps),
+            ));
+            measurements.push(m);
+        }
+    }
+    let mut p = Problem::new(
+        "torque-free body: orientation updates",
+        TUMBLER,
+        TUMBLER_REFERENCE,
+        1.0,
+        SweepReport {
+            measurements,
+            reference_seconds_per_step: None,
+        },
+    );
+    p.default = names
+        .iter()
+        .position(|(s, l)| s == "Splitting" && l == "SE×4");
+    p.names = Some(names);
+    Ok(p)
 }
 
 fn rope(world: &mut World) -> hooke::Result<()> {
