@@ -241,3 +241,30 @@ fn cheapest_within_and_the_pareto_front() {
         ]
     );
 }
+
+#[test]
+fn cheapest_within_on_a_real_sweep_is_the_fastest_setting_within_tolerance() {
+    let report = sweep(
+        oscillator,
+        x,
+        &Setting::grid(&Integrator::ALL, &[1, 2, 4, 8]),
+        exact_x(),
+        Sweep::seconds(10.3).with_timing_runs(1),
+    )
+    .unwrap();
+    for tol in [0.05, 0.01, 1e-3, 1e-4] {
+        let best = report.cheapest_within(tol).unwrap();
+        println!("within {tol:e}: {} ({:.2e})", best.setting, best.error);
+        assert!(best.error <= tol);
+        for m in report.measurements.iter().filter(|m| m.error <= tol) {
+            assert!(m.seconds_per_step >= best.seconds_per_step);
+        }
+    }
+    // RK4 is the only integrator within 1e-4 of the closed form at these substeps.
+    assert_eq!(
+        report.cheapest_within(1e-4).unwrap().setting.integrator,
+        Integrator::Rk4
+    );
+    // Nothing diverged to a finite error: explicit Euler ×1's 25.75 is reported as such.
+    assert!(report.measurements.iter().all(|m| !m.quarantined));
+}
