@@ -31,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let quick = std::env::args().any(|a| a == "--quick");
     let start = Instant::now();
     type Build = fn(bool) -> hooke::Result<Problem>;
-    let all: [(&str, Build); 12] = [
+    let all: [(&str, Build); 13] = [
         ("oscillator", problems::oscillator),
         ("damped", problems::damped_oscillator),
         ("pendulum", problems::pendulum),
@@ -43,6 +43,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("bounce", problems::bouncing_ball),
         ("incline", problems::incline),
         ("fem", fem::cantilever),
+        ("beam", fem::swinging_beam),
         ("cloth", problems::cloth),
     ];
     let mut done = Vec::new();
