@@ -31,11 +31,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let quick = std::env::args().any(|a| a == "--quick");
     let start = Instant::now();
     type Build = fn(bool) -> hooke::Result<Problem>;
-    let all: [(&str, Build); 13] = [
+    let all: [(&str, Build); 14] = [
         ("oscillator", problems::oscillator),
         ("damped", problems::damped_oscillator),
         ("pendulum", problems::pendulum),
         ("kepler", problems::kepler),
+        ("kepler-energy", problems::kepler_energy),
         ("torque-free", problems::torque_free),
         ("orientation", problems::orientation_updates),
         ("chain", problems::stiff_chain),

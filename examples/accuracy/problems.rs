@@ -253,25 +253,27 @@ fn attract(mut q: Query<(&Position, &mut hooke::Force), With<Orbiting>>) {
     }
 }
 
+/// The orbit from perihelion (0.5 m, e = 0.5, a = 1 m: T = 1 s).
+fn orbit(w: &mut World) -> hooke::Result<()> {
+    base(w, Vec3::ZERO)?;
+    let vp = TAU * 3f64.sqrt();
+    w.spawn((
+        ParticleBundle::new(
+            Vec3::new(0.5, 0.0, 0.0),
+            Vec3::new(0.0, vp as f32, 0.0),
+            1.0,
+        )?,
+        Observed,
+        Orbiting,
+    ));
+    add_force_systems(w, || attract.in_set(ForceSystems::User));
+    Ok(())
+}
+
 pub fn kepler(quick: bool) -> hooke::Result<Problem> {
     let e = 0.5f64;
-    // Perihelion at 0.5 m with a = 1 m: T = 1 s.
-    let vp = TAU * ((1.0 + e) / (1.0 - e)).sqrt();
     let report = sweep(
-        move |w: &mut World| {
-            base(w, Vec3::ZERO)?;
-            w.spawn((
-                ParticleBundle::new(
-                    Vec3::new(0.5, 0.0, 0.0),
-                    Vec3::new(0.0, vp as f32, 0.0),
-                    1.0,
-                )?,
-                Observed,
-                Orbiting,
-            ));
-            add_force_systems(w, || attract.in_set(ForceSystems::User));
-            Ok(())
-        },
+        orbit,
         observed_positions,
         &settings(),
         Reference::exact(move |t| {
@@ -288,9 +290,36 @@ pub fn kepler(quick: bool) -> hooke::Result<Problem> {
     )?;
     Ok(Problem::new(
         "Kepler orbit (e = 0.5)",
-        "max position error over 2.3 orbits, per 1 m semi-major axis",
+        "max position error over 2.3 orbits (phase, shape and precession), per 1 m semi-major axis",
         "closed form (Kepler's equation)",
         1.0,
+        report,
+    ))
+}
+
+/// The same orbit's specific energy v²/2 − GM/r against −GM/(2a).
+pub fn kepler_energy(quick: bool) -> hooke::Result<Problem> {
+    let energy = -f64::from(GM) / 2.0;
+    let report = sweep(
+        orbit,
+        |w: &mut World| {
+            let mut q = w.query_filtered::<(&Position, &LinearVelocity), With<Observed>>();
+            q.iter(w)
+                .map(|(x, v)| {
+                    let (x, v) = (x.get().as_dvec3(), v.get().as_dvec3());
+                    (0.5 * v.length_squared() - f64::from(GM) / x.length()) as f32
+                })
+                .collect()
+        },
+        &settings(),
+        Reference::exact(move |_| vec![energy]),
+        Sweep::seconds(2.3).with_timing_runs(runs(quick)),
+    )?;
+    Ok(Problem::new(
+        "Kepler orbit: energy",
+        "max |E − E₀| over 2.3 orbits, per |E₀| = 2π² J/kg",
+        "closed form (E₀ = −GM/2a)",
+        -energy,
         report,
     ))
 }
