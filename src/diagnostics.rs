@@ -126,10 +126,10 @@ struct SetClock {
 }
 
 pub(crate) fn install(world: &mut World) {
-    world.init_resource::<PhysicsDiagnostics>();
+    crate::restore::init::<PhysicsDiagnostics>(world);
     world.add_observer(count_quarantine);
-    world.init_resource::<DiagnosticsSettings>();
-    world.init_resource::<SetClock>();
+    crate::restore::init::<DiagnosticsSettings>(world);
+    crate::restore::init::<SetClock>(world);
     for k in 0..=9u8 {
         add_systems(
             world,

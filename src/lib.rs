@@ -149,6 +149,7 @@ pub mod integrator;
 pub mod particles;
 pub mod quarantine;
 pub mod rest;
+pub mod restore;
 pub mod rigid;
 pub mod scenes;
 pub mod schedule;
@@ -247,9 +248,17 @@ impl WorldPlugin for PhysicsCorePlugin {
         if !world.contains_resource::<PhysicsTime>() {
             world.insert_resource(PhysicsTime::default());
         }
-        world.init_resource::<SubstepTime>();
-        world.init_resource::<Messages<BodyQuarantined>>();
-        world.init_resource::<quarantine::DivergenceGuard>();
+        restore::init::<PhysicsTime>(world);
+        restore::init::<Messages<restore::ResourceRestored>>(world);
+        restore::init::<Messages<restore::InvalidSetting>>(world);
+        schedule::add_systems(
+            world,
+            PhysicsSchedule,
+            restore::restore_resources.in_set(PhysicsSystems::Restore),
+        );
+        crate::restore::init::<SubstepTime>(world);
+        crate::restore::init::<Messages<BodyQuarantined>>(world);
+        crate::restore::init::<quarantine::DivergenceGuard>(world);
         schedule::add_systems(
             world,
             PhysicsSchedule,
@@ -322,6 +331,12 @@ fn rotate_messages(world: &mut World) {
     if let Some(mut m) = world.get_resource_mut::<Messages<springs::StabilityWarning>>() {
         m.update();
     }
+    if let Some(mut m) = world.get_resource_mut::<Messages<restore::ResourceRestored>>() {
+        m.update();
+    }
+    if let Some(mut m) = world.get_resource_mut::<Messages<restore::InvalidSetting>>() {
+        m.update();
+    }
 }
 
 pub(crate) fn run_step(world: &mut World) {
@@ -345,13 +360,21 @@ impl PhysicsWorldExt for World {
 
     fn step_physics(&mut self) {
         if !self.contains_resource::<PhysicsTime>() {
-            return;
+            // The clock itself was removed (the step's own restore pass would not run):
+            // put everything back first; without the core plugin this does nothing.
+            restore::restore_resources(self);
+            if !self.contains_resource::<PhysicsTime>() {
+                return;
+            }
         }
         rotate_messages(self);
         run_step(self);
     }
 
     fn advance_physics(&mut self, frame_dt: f32) -> Result<FrameReport> {
+        if !self.contains_resource::<PhysicsTime>() {
+            restore::restore_resources(self);
+        }
         let Some(mut time) = self.get_resource_mut::<PhysicsTime>() else {
             return Ok(FrameReport::default());
         };

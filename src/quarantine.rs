@@ -38,6 +38,12 @@ pub enum QuarantineReason {
         /// The mesh node, for a [`crate::Nodes`] mesh.
         node: Option<u32>,
     },
+    /// The collision geometry library failed (panicked) on its pair with `other`: a shape at
+    /// the edge of what parry handles. The pair is dropped.
+    GeometryFailed {
+        /// The other collider of the pair.
+        other: Entity,
+    },
     /// A spring attached to it failed: its force was not finite, or its strain |l − r| / r
     /// passed [`DivergenceGuard::max_spring_strain`].
     SpringFailed {
@@ -94,7 +100,7 @@ impl DivergenceGuard {
 
 /// Marks a body that is no longer simulated. See the module docs.
 #[derive(Component, Debug, Clone, PartialEq)]
-#[component(on_insert = report_quarantine)]
+#[component(on_add = report_quarantine)]
 pub struct Quarantined {
     /// Why.
     pub reason: QuarantineReason,
@@ -111,7 +117,9 @@ pub struct BodyQuarantined {
     pub reason: QuarantineReason,
 }
 
-/// Writes the message. Effects that care (diagnostics' counts, the broad phase's lists)
+/// Writes the message, once per body: a second insert while the body is quarantined (a
+/// spring's two ends, a NaN found by two systems in one step) only replaces the reason.
+/// Effects that care (diagnostics' counts, the broad phase's lists)
 /// observe the insert themselves: the core calls none of them.
 fn report_quarantine(mut world: DeferredWorld, ctx: HookContext) {
     let Some(reason) = world
@@ -149,4 +157,35 @@ pub(crate) fn validate_on_insert<T: Component + Validate>(
     world.commands().entity(ctx.entity).insert(Quarantined {
         reason: QuarantineReason::InvalidInput(err),
     });
+}
+
+/// A `T` changed since the last step, on a body still simulated.
+type ChangedLive<T> = (Changed<T>, Without<Quarantined>);
+
+/// Values written through `get_mut` (or any other way past the insert hook): each step,
+/// before anything reads them, every changed `T` is validated as an insert would be, and a
+/// body with a bad value is quarantined. For cold configuration only (materials, damping,
+/// targets): hot state is checked by the integrators' finiteness probes.
+pub(crate) fn validate_changed<T: Component + Validate>(
+    mut commands: Commands,
+    changed: Query<(Entity, &T), ChangedLive<T>>,
+) {
+    for (e, value) in &changed {
+        if let Err(err) = value.validate() {
+            commands.entity(e).try_insert(Quarantined {
+                reason: QuarantineReason::InvalidInput(err),
+            });
+        }
+    }
+}
+
+/// Adds [`validate_changed`] for `T` to the step (effects call it for their cold components).
+pub(crate) fn validate_writes<T: Component + Validate>(world: &mut World) {
+    crate::schedule::add_systems(
+        world,
+        crate::schedule::PhysicsSchedule,
+        validate_changed::<T>
+            .run_if(any_with_component::<T>)
+            .in_set(crate::schedule::PrepareSystems::Inputs),
+    );
 }

@@ -2,6 +2,7 @@
 //!
 //! ```text
 //! PhysicsSchedule            one fixed step of length dt
+//!   PhysicsSystems::Restore    re-create removed resources
 //!   PhysicsSystems::Prepare    drop broken springs, derived data
 //!   PhysicsSystems::Step       runs SubstepSchedule `substeps` times, h = dt / substeps
 //!   PhysicsSystems::Finish     attached colliders' poses, then diagnostics
@@ -49,6 +50,8 @@ pub struct ForceSchedule;
 /// The sets of [`PhysicsSchedule`], in run order.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum PhysicsSystems {
+    /// Resources game code removed are re-created (see [`crate::restore`]).
+    Restore,
     /// Derived data and bookkeeping before the substeps.
     Prepare,
     /// Runs the substeps.
@@ -204,6 +207,7 @@ pub(crate) fn init_schedules(world: &mut World) {
     let mut physics = new_schedule(PhysicsSchedule, true);
     physics.configure_sets(
         (
+            PhysicsSystems::Restore,
             PhysicsSystems::Prepare,
             PhysicsSystems::Step,
             PhysicsSystems::Finish,

@@ -65,7 +65,7 @@ pub struct SleepPlugin;
 
 impl WorldPlugin for SleepPlugin {
     fn build(&self, world: &mut World) {
-        world.init_resource::<SleepSettings>();
+        crate::restore::init::<SleepSettings>(world);
         add_systems(
             world,
             PhysicsSchedule,
@@ -95,6 +95,7 @@ type Disturbed = (
         Changed<Rotation>,
         Changed<LinearVelocity>,
         Changed<AngularVelocity>,
+        Changed<AngularMomentum>,
         Changed<ExternalForce>,
         Changed<ExternalImpulse>,
         Changed<ExternalTorque>,

@@ -202,12 +202,13 @@ pub(crate) fn run_substeps<Bodies: bevy_ecs::query::QueryFilter>(
         }
         for i in 0..n {
             let t = (t0 + f64::from(h) * f64::from(i)) as f32;
-            *world.resource_mut::<SubstepTime>() = SubstepTime {
+            // Inserted, not written through: a system of the substep may have removed it.
+            world.insert_resource(SubstepTime {
                 h,
                 t,
                 index: i,
                 count: n,
-            };
+            });
 
             schedule.run(world);
         }

@@ -127,6 +127,8 @@ fn register_messages(world: &mut World) {
     MessageRegistry::register_message::<ContactEnded>(world);
     MessageRegistry::register_message::<BodyQuarantined>(world);
     MessageRegistry::register_message::<crate::StabilityWarning>(world);
+    MessageRegistry::register_message::<crate::restore::ResourceRestored>(world);
+    MessageRegistry::register_message::<crate::restore::InvalidSetting>(world);
     world.insert_resource(MessagesRegistered);
 }
 

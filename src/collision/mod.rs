@@ -142,15 +142,72 @@ impl ColliderChanges {
     }
 }
 
+/// Positive sizes for the primitive shapes parry would otherwise accept.
+fn check_sizes(shape: &SharedShape) -> Result<()> {
+    use parry3d::shape::TypedShape;
+    match shape.as_typed_shape() {
+        TypedShape::Ball(b) => positive_len("ball radius", b.radius).map(|_| ()),
+        TypedShape::Cuboid(c) => {
+            for h in c.half_extents.to_array() {
+                positive_len("half extent", h)?;
+            }
+            Ok(())
+        }
+        TypedShape::Capsule(c) => positive_len("capsule radius", c.radius).map(|_| ()),
+        TypedShape::Cylinder(c) => {
+            positive_len("cylinder half height", c.half_height)?;
+            positive_len("cylinder radius", c.radius).map(|_| ())
+        }
+        TypedShape::Cone(c) => {
+            positive_len("cone half height", c.half_height)?;
+            positive_len("cone radius", c.radius).map(|_| ())
+        }
+        TypedShape::RoundCuboid(c) => {
+            for h in c.inner_shape.half_extents.to_array() {
+                positive_len("half extent", h)?;
+            }
+            non_negative("border radius", c.border_radius).map(|_| ())
+        }
+        _ => Ok(()),
+    }
+}
+
 impl Collider {
-    /// Wraps any parry shape after checking that its bounds are finite.
+    /// The largest distance a collider's bounds may reach from its origin (m). Beyond it f32
+    /// resolves positions to worse than 6 cm, and parry's penetration search (EPA) has been
+    /// seen to fail with an index panic on such shapes (a cylinder of half height 1e20, a
+    /// cuboid of half extent 1e30).
+    pub const MAX_EXTENT: f32 = 1e6;
+
+    /// Wraps any parry shape after checking that it is one the collision code can handle:
+    /// finite bounds no larger than [`Collider::MAX_EXTENT`], and positive sizes for the
+    /// primitive shapes (a zero-radius ball or a negative cuboid is no shape).
     ///
     /// # Errors
-    /// [`Error::NonFinite`] for a shape with non-finite bounds.
+    /// [`Error::NonFinite`] for a shape with non-finite bounds, [`Error::OutOfRange`] for one
+    /// larger than [`Collider::MAX_EXTENT`] or with its bounds inverted or collapsed to a
+    /// point, [`Error::NotPositive`] for a primitive with a non-positive size.
     pub fn new(shape: SharedShape) -> Result<Self> {
+        check_sizes(&shape)?;
         let aabb = shape.compute_local_aabb();
         finite_vec("collider bounds", aabb.mins)?;
         finite_vec("collider bounds", aabb.maxs)?;
+        let extent = aabb.mins.abs().max(aabb.maxs.abs()).max_element();
+        if extent > Self::MAX_EXTENT {
+            return Err(Error::OutOfRange {
+                what: "collider extent from its origin (m)",
+                value: extent,
+                range: "at most 1e6 m (Collider::MAX_EXTENT)",
+            });
+        }
+        let size = aabb.maxs - aabb.mins;
+        if size.min_element() < 0.0 || size.max_element() <= 0.0 {
+            return Err(Error::OutOfRange {
+                what: "collider size (m)",
+                value: size.max_element(),
+                range: "bounds with a positive size",
+            });
+        }
         Ok(Self {
             shape,
             bounds: [aabb.mins, aabb.maxs],
@@ -215,11 +272,19 @@ impl Collider {
         for p in points {
             finite_vec("hull point", *p)?;
         }
-        let shape = SharedShape::convex_hull(points).ok_or(Error::TooFew {
+        let too_few = Error::TooFew {
             what: "non-coplanar hull points",
             min: 4,
             got: points.len(),
-        })?;
+        };
+        let shape = SharedShape::convex_hull(points).ok_or(too_few.clone())?;
+        // parry builds a flat "hull" from 3 points or a coplanar set: no volume, no inertia.
+        let volume = shape.mass_properties(1.0).mass();
+        let aabb = shape.compute_local_aabb();
+        let size = (aabb.maxs - aabb.mins).max_element();
+        if volume.partial_cmp(&(1e-9 * size * size * size)) != Some(std::cmp::Ordering::Greater) {
+            return Err(too_few);
+        }
         Self::new(shape)
     }
 
@@ -260,7 +325,16 @@ impl Collider {
     /// # Errors
     /// [`Error::TooFew`] for fewer than 2 × 2 heights or a size mismatch.
     pub fn heightfield(nrows: usize, ncols: usize, heights: Vec<f32>, scale: Vec3) -> Result<Self> {
-        if nrows < 2 || ncols < 2 || heights.len() != nrows * ncols {
+        // The product is checked: 2^62 × 4 wraps to 0 and matched an empty height list, then
+        // overflowed parry's allocation.
+        let Some(count) = nrows.checked_mul(ncols) else {
+            return Err(Error::OutOfRange {
+                what: "heightfield rows × columns",
+                value: nrows as f32 * ncols as f32,
+                range: "a count that fits in memory",
+            });
+        };
+        if nrows < 2 || ncols < 2 || heights.len() != count {
             return Err(Error::TooFew {
                 what: "heights (at least 2 × 2, rows × cols)",
                 min: 4,

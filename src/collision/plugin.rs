@@ -29,13 +29,21 @@ pub struct CollisionPlugin;
 
 impl WorldPlugin for CollisionPlugin {
     fn build(&self, world: &mut World) {
-        world.init_resource::<ContactSettings>();
-        world.init_resource::<super::ColliderChanges>();
-        world.init_resource::<BroadPhase>();
-        world.init_resource::<Contacts>();
-        world.init_resource::<ContactSolver>();
-        world.init_resource::<bevy_ecs::message::Messages<ContactStarted>>();
-        world.init_resource::<bevy_ecs::message::Messages<ContactEnded>>();
+        crate::restore::init::<ContactSettings>(world);
+        crate::quarantine::validate_writes::<super::Friction>(world);
+        crate::quarantine::validate_writes::<super::Restitution>(world);
+        crate::quarantine::validate_writes::<super::RestitutionThreshold>(world);
+        add_systems(
+            world,
+            PhysicsSchedule,
+            correct_contact_settings.in_set(crate::schedule::PrepareSystems::Inputs),
+        );
+        crate::restore::init::<super::ColliderChanges>(world);
+        crate::restore::init::<BroadPhase>(world);
+        crate::restore::init::<Contacts>(world);
+        crate::restore::init::<ContactSolver>(world);
+        crate::restore::init::<bevy_ecs::message::Messages<ContactStarted>>(world);
+        crate::restore::init::<bevy_ecs::message::Messages<ContactEnded>>(world);
         // Impulses from mesh nodes (soft bodies, cloth) reach their bodies at the start of the
         // next substep, before the bodies' own integrators.
         add_systems(
@@ -304,6 +312,8 @@ struct NarrowBody<'a> {
     /// The collider was replaced or changed since the last step.
     changed: bool,
     sensor: bool,
+    /// It has a velocity (a dynamic or kinematic body's collider, or a particle's).
+    moving: bool,
 }
 
 impl<'a> NarrowBody<'a> {
@@ -340,6 +350,7 @@ fn narrow_body<'a>(
         extent: lo.abs().max(hi.abs()).length(),
         changed,
         sensor,
+        moving: v.is_some(),
     }
 }
 
@@ -359,6 +370,7 @@ fn update_contacts(
     mut ended: MessageWriter<ContactEnded>,
     sleeping: Query<(), With<Sleeping>>,
     mut buffers: Local<NarrowBuffers>,
+    mut commands: Commands,
 ) {
     let (wanted, pair_slots, scratch) = &mut *buffers;
     wanted.clear();
@@ -391,63 +403,90 @@ fn update_contacts(
         state.seen = step;
         state.sensor = sensor;
         state.cast = None;
-        let touching = if sensor {
-            let (sa, sb) = (&**ca.collider.shape(), &**cb.collider.shape());
-            parry3d::query::intersection_test(pose_a, sa, pose_b, sb).is_ok_and(|i| i.intersecting)
-        } else {
-            let prediction = settings.margin + (ca.speed + cb.speed) * dt;
-            let pos12 = pose_a.inverse() * *pose_b;
-            let changed = ca.changed || cb.changed;
-            match state.recycle {
-                Some(r) if !changed && r.holds(&pos12, cb.extent, prediction, window) => {
-                    for m in &mut state.manifolds {
-                        m.update_separations(&part_pose12(m, &pos12));
+        // parry can still panic on shapes at the edge of its domain (EPA's index panic was
+        // seen on huge or badly turned shapes): one bad pair loses its contact and its moving
+        // sides are quarantined, and the step goes on.
+        let found = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            if sensor {
+                let (sa, sb) = (&**ca.collider.shape(), &**cb.collider.shape());
+                parry3d::query::intersection_test(pose_a, sa, pose_b, sb)
+                    .is_ok_and(|i| i.intersecting)
+            } else {
+                let prediction = settings.margin + (ca.speed + cb.speed) * dt;
+                let pos12 = pose_a.inverse() * *pose_b;
+                let changed = ca.changed || cb.changed;
+                match state.recycle {
+                    Some(r) if !changed && r.holds(&pos12, cb.extent, prediction, window) => {
+                        for m in &mut state.manifolds {
+                            m.update_separations(&part_pose12(m, &pos12));
+                        }
+                    }
+                    _ => {
+                        if changed {
+                            // parry reuses points itself while a pose holds still, and cannot tell
+                            // that a shape changed: start from nothing.
+                            state.manifolds.clear();
+                            state.workspace = None;
+                        }
+                        let reach = prediction + window;
+                        let result = DefaultQueryDispatcher.contact_manifolds(
+                            &pos12,
+                            &**ca.collider.shape(),
+                            &**cb.collider.shape(),
+                            reach,
+                            &mut state.manifolds,
+                            &mut state.workspace,
+                        );
+                        if result.is_err() {
+                            state.manifolds.clear();
+                        }
+                        state.recycle =
+                            (window > 0.0 && result.is_ok()).then_some(Recycle { pos12, reach });
+                        for m in &mut state.manifolds {
+                            choose_points(m, scratch);
+                        }
                     }
                 }
-                _ => {
-                    if changed {
-                        // parry reuses points itself while a pose holds still, and cannot tell
-                        // that a shape changed: start from nothing.
-                        state.manifolds.clear();
-                        state.workspace = None;
-                    }
-                    let reach = prediction + window;
-                    let result = DefaultQueryDispatcher.contact_manifolds(
-                        &pos12,
-                        &**ca.collider.shape(),
-                        &**cb.collider.shape(),
-                        reach,
-                        &mut state.manifolds,
-                        &mut state.workspace,
-                    );
-                    if result.is_err() {
-                        state.manifolds.clear();
-                    }
-                    state.recycle =
-                        (window > 0.0 && result.is_ok()).then_some(Recycle { pos12, reach });
-                    for m in &mut state.manifolds {
-                        choose_points(m, scratch);
+                let thin = super::ccd::pair_thickness(ca.thin, cb.thin, settings.margin);
+                let sweep = (cb.velocity - ca.velocity).length() + ca.swing.max(cb.swing);
+                if super::ccd::is_fast(sweep, dt, thin) {
+                    state.cast = super::ccd::impact_manifold(
+                        &ca.cast_side(),
+                        &cb.cast_side(),
+                        dt,
+                        thin,
+                        &state.manifolds,
+                        scratch,
+                    )
+                    .map(Box::new);
+                }
+                state
+                    .manifolds
+                    .iter()
+                    .flat_map(|m| &m.points)
+                    .any(|p| p.dist < touch)
+            }
+        }));
+        let touching = match found {
+            Ok(touching) => touching,
+            Err(_) => {
+                state.manifolds.clear();
+                state.workspace = None;
+                state.recycle = None;
+                state.cast = None;
+                for (side, body, other) in [(a, ca, b), (b, cb, a)] {
+                    if body.moving {
+                        commands
+                            .entity(side)
+                            .try_insert(crate::quarantine::Quarantined {
+                                reason: crate::quarantine::QuarantineReason::GeometryFailed {
+                                    other,
+                                },
+                            });
                     }
                 }
+                false
             }
-            let thin = super::ccd::pair_thickness(ca.thin, cb.thin, settings.margin);
-            let sweep = (cb.velocity - ca.velocity).length() + ca.swing.max(cb.swing);
-            if super::ccd::is_fast(sweep, dt, thin) {
-                state.cast = super::ccd::impact_manifold(
-                    &ca.cast_side(),
-                    &cb.cast_side(),
-                    dt,
-                    thin,
-                    &state.manifolds,
-                    scratch,
-                )
-                .map(Box::new);
-            }
-            state
-                .manifolds
-                .iter()
-                .flat_map(|m| &m.points)
-                .any(|p| p.dist < touch)
         };
         if touching != state.touching {
             state.touching = touching;
@@ -570,4 +609,52 @@ fn relax_contacts(
         }
     }
     scatter(&mut solver, &mut bodies);
+}
+
+/// Settings written with bad values (NaN, negative) are put back to their defaults, field by
+/// field, each with an [`InvalidSetting`](crate::restore::InvalidSetting) message: a NaN
+/// `max_push_velocity` or a negative `margin` dropped bodies through the ground, a negative
+/// damping ratio exploded a stack. Runs only in a step after the resource changed.
+fn correct_contact_settings(
+    mut settings: ResMut<ContactSettings>,
+    mut invalid: MessageWriter<crate::restore::InvalidSetting>,
+) {
+    if !settings.is_changed() {
+        return;
+    }
+    let d = ContactSettings::default();
+    let current = *settings;
+    // (`recycle_distance` and `max_rotation` are left alone: negative or NaN documentedly
+    // means "no reuse" and "no limit". A hertz of zero or less means rigid contacts.)
+    let ok = |v: f32, finite: bool| v >= 0.0 && (!finite || v.is_finite());
+    let fields: [(&'static str, f32, f32, bool); 5] = [
+        ("hertz", current.hertz.abs(), d.hertz, true),
+        ("damping_ratio", current.damping_ratio, d.damping_ratio, true),
+        ("max_push_velocity", current.max_push_velocity, d.max_push_velocity, false),
+        ("restitution_threshold", current.restitution_threshold, d.restitution_threshold, false),
+        ("margin", current.margin, d.margin, true),
+    ];
+    let mut fixed = current;
+    let mut any = false;
+    for (field, value, default, finite) in fields {
+        if ok(value, finite) {
+            continue;
+        }
+        any = true;
+        invalid.write(crate::restore::InvalidSetting {
+            resource: "ContactSettings",
+            field,
+            value,
+        });
+        match field {
+            "hertz" => fixed.hertz = default,
+            "damping_ratio" => fixed.damping_ratio = default,
+            "max_push_velocity" => fixed.max_push_velocity = default,
+            "restitution_threshold" => fixed.restitution_threshold = default,
+            _ => fixed.margin = default,
+        }
+    }
+    if any {
+        *settings = fixed;
+    }
 }

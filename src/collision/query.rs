@@ -186,10 +186,14 @@ impl SpatialQuery<'_, '_> {
         filter: &QueryFilter,
     ) -> Option<Hit> {
         let dir = direction.try_normalize()?;
-        let start = Pose::from_parts(position, rotation.normalize());
+        let rotation = unit_rotation(rotation)?;
+        if !(position.is_finite() && max_distance >= 0.0 && max_distance.is_finite()) {
+            return None;
+        }
+        let start = Pose::from_parts(position, rotation);
         let swept = shape.shape().compute_swept_aabb(
             &start,
-            &Pose::from_parts(position + dir * max_distance, rotation.normalize()),
+            &Pose::from_parts(position + dir * max_distance, rotation),
         );
         let options = ShapeCastOptions::with_max_time_of_impact(max_distance);
         let mut best = None;
@@ -198,16 +202,18 @@ impl SpatialQuery<'_, '_> {
                 continue;
             }
             let target = pose(x, q, com);
-            let hit = parry3d::query::cast_shapes(
-                &start,
-                dir,
-                &**shape.shape(),
-                &target,
-                Vec3::ZERO,
-                &**c.shape(),
-                options,
-            );
-            if let Ok(Some(h)) = hit {
+            let hit = guarded(|| {
+                parry3d::query::cast_shapes(
+                    &start,
+                    dir,
+                    &**shape.shape(),
+                    &target,
+                    Vec3::ZERO,
+                    &**c.shape(),
+                    options,
+                )
+            });
+            if let Some(Ok(Some(h))) = hit {
                 nearer(
                     &mut best,
                     Hit {
@@ -231,6 +237,9 @@ impl SpatialQuery<'_, '_> {
         max_distance: f32,
         filter: &QueryFilter,
     ) -> Option<Projection> {
+        if !(point.is_finite() && max_distance >= 0.0) {
+            return None;
+        }
         let mut best: Option<Projection> = None;
         for (e, c, x, q, com, _, aabb, _) in self.candidates(filter) {
             let gap = (aabb.min - point)
@@ -276,7 +285,13 @@ impl SpatialQuery<'_, '_> {
         rotation: Quat,
         filter: &QueryFilter,
     ) -> Vec<Entity> {
-        let at = Pose::from_parts(position, rotation.normalize());
+        let Some(rotation) = unit_rotation(rotation) else {
+            return Vec::new();
+        };
+        if !position.is_finite() {
+            return Vec::new();
+        }
+        let at = Pose::from_parts(position, rotation);
         let bounds = shape.shape().compute_aabb(&at);
         let mut out: Vec<Entity> = self
             .candidates(filter)
@@ -284,17 +299,31 @@ impl SpatialQuery<'_, '_> {
                 !(bounds.maxs.cmplt(aabb.min).any() || bounds.mins.cmpgt(aabb.max).any())
             })
             .filter(|(_, c, x, q, com, ..)| {
-                parry3d::query::intersection_test(
-                    &at,
-                    &**shape.shape(),
-                    &pose(x, q, *com),
-                    &**c.shape(),
-                )
-                .is_ok_and(|i| i.intersecting)
+                guarded(|| {
+                    parry3d::query::intersection_test(
+                        &at,
+                        &**shape.shape(),
+                        &pose(x, q, *com),
+                        &**c.shape(),
+                    )
+                })
+                .is_some_and(|i| i.is_ok_and(|i| i.intersecting))
             })
             .map(|c| c.0)
             .collect();
         out.sort_unstable();
         out
     }
+}
+
+/// `q` as a unit quaternion; none for a zero or non-finite one (whose "normalised" form is
+/// NaN and made every query answer with NaN hits).
+fn unit_rotation(q: Quat) -> Option<Quat> {
+    crate::Rotation::try_new(q).ok().map(|r| r.0)
+}
+
+/// Runs a parry query, with a panic inside parry (seen on shapes at the edge of its domain)
+/// answered as no result instead of unwinding into the caller's system.
+fn guarded<T>(f: impl FnOnce() -> T) -> Option<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).ok()
 }

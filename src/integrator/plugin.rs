@@ -37,8 +37,8 @@ pub struct IntegratorPlugin;
 
 impl WorldPlugin for IntegratorPlugin {
     fn build(&self, world: &mut World) {
-        world.init_resource::<Integrator>();
-        world.init_resource::<ConstraintsActive>();
+        crate::restore::init::<Integrator>(world);
+        crate::restore::init::<ConstraintsActive>(world);
         add_force_systems(world, || clear_forces.in_set(StepSystems::ClearForces));
         add_systems(
             world,

@@ -23,7 +23,8 @@ pub struct GravityPlugin;
 
 impl WorldPlugin for GravityPlugin {
     fn build(&self, world: &mut World) {
-        world.init_resource::<Gravity>();
+        crate::restore::init::<Gravity>(world);
+        crate::quarantine::validate_writes::<super::GravityScale>(world);
     }
 }
 
@@ -53,7 +54,7 @@ pub struct VelocityFieldPlugin;
 
 impl WorldPlugin for VelocityFieldPlugin {
     fn build(&self, world: &mut World) {
-        world.init_resource::<Advection>();
+        crate::restore::init::<Advection>(world);
         add_systems(
             world,
             SubstepSchedule,

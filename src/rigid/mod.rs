@@ -106,8 +106,18 @@ impl Rotation {
     /// # Errors
     /// [`Error::NonFinite`] for a non-finite or zero quaternion.
     pub fn try_new(q: Quat) -> Result<Self> {
-        Rotation(q).validate()?;
-        Ok(Self(q.normalize()))
+        // Scaled by its largest component first: |q|² of (0, 0, 0, 1e20) overflows f32, and
+        // normalising it directly gave the zero quaternion.
+        let big = glam::Vec4::from(q).abs().max_element();
+        if !(big.is_finite() && big > 0.0) {
+            return Err(Error::NonFinite {
+                what: "rotation (finite and non-zero)",
+                value: format!("{q}"),
+            });
+        }
+        let scaled = Quat::from_vec4(glam::Vec4::from(q) / big);
+        Rotation(scaled).validate()?;
+        Ok(Self(scaled.normalize()))
     }
 }
 

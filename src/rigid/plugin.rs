@@ -29,8 +29,10 @@ pub struct RigidBodyPlugin;
 
 impl WorldPlugin for RigidBodyPlugin {
     fn build(&self, world: &mut World) {
-        world.init_resource::<OrientationUpdate>();
-        world.init_resource::<Renormalization>();
+        crate::restore::init::<OrientationUpdate>(world);
+        crate::quarantine::validate_writes::<super::AngularDamping>(world);
+        crate::quarantine::validate_writes::<super::KinematicTarget>(world);
+        crate::restore::init::<Renormalization>(world);
         add_systems(
             world,
             PhysicsSchedule,

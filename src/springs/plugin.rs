@@ -48,9 +48,9 @@ impl WorldPlugin for SpringPlugin {
                 .run_if(any_with_component::<crate::integrator::ImplicitEuler>)
                 .in_set(crate::schedule::ImplicitSystems::Springs),
         );
-        world.init_resource::<super::EntitySpringStability>();
-        world.init_resource::<super::StabilityPolicy>();
-        world.init_resource::<bevy_ecs::message::Messages<super::StabilityWarning>>();
+        crate::restore::init::<super::EntitySpringStability>(world);
+        crate::restore::init::<super::StabilityPolicy>(world);
+        crate::restore::init::<bevy_ecs::message::Messages<super::StabilityWarning>>(world);
         add_systems(
             world,
             PhysicsSchedule,
