@@ -440,3 +440,45 @@ pub fn column_spec(n: usize) -> Vec<BoxSpec> {
 pub fn box_column(world: &mut World, n: usize) -> Result<Vec<Entity>> {
     spawn_boxes(world, &column_spec(n))
 }
+
+/// A soft beam along x from 0 to `length` (m), square `side` (m), meshed `cells` (6 tets a
+/// cell), with its nodes at x = 0 pinned: the cantilever of the FEM tests and the accuracy
+/// chart.
+///
+/// # Errors
+/// Mesh and material errors for bad sizes.
+pub fn pinned_beam(
+    length: f32,
+    side: f32,
+    cells: [usize; 3],
+    material: crate::soft::Material,
+    model: crate::soft::StrainModel,
+) -> Result<(crate::Nodes, crate::soft::SoftBody)> {
+    use crate::soft::{CellSplit, SoftBody, TetMesh};
+    let mesh = TetMesh::cuboid(Vec3::new(length, side, side), cells, CellSplit::Six)?;
+    let (mut nodes, body) =
+        SoftBody::build(&mesh, Vec3::new(0.5 * length, 0.0, 0.0), material, model)?;
+    for i in 0..nodes.len() {
+        if nodes.positions()[i].x.abs() < 1e-5 {
+            nodes.pin(i)?;
+        }
+    }
+    Ok((nodes, body))
+}
+
+/// The catenary parameter a (m) of a chain of `length` hung between two pins `span` apart
+/// at one height: the root of L = 2a sinh(S / 2a), by bisection (the right side falls as a
+/// grows). Its sag is a (cosh(S / 2a) − 1), its support tension w a cosh(S / 2a).
+#[must_use]
+pub fn catenary_parameter(span: f64, length: f64) -> f64 {
+    let (mut lo, mut hi) = (1e-3 * span, 1e3 * span);
+    for _ in 0..200 {
+        let a = 0.5 * (lo + hi);
+        if 2.0 * a * (span / (2.0 * a)).sinh() > length {
+            lo = a;
+        } else {
+            hi = a;
+        }
+    }
+    0.5 * (lo + hi)
+}

@@ -22,15 +22,7 @@ fn beam(
     material: Material,
     model: StrainModel,
 ) -> (Nodes, SoftBody) {
-    let mesh = TetMesh::cuboid(Vec3::new(length, side, side), cells, CellSplit::Six).unwrap();
-    let (mut nodes, body) =
-        SoftBody::build(&mesh, Vec3::new(0.5 * length, 0.0, 0.0), material, model).unwrap();
-    for i in 0..nodes.len() {
-        if nodes.positions()[i].x.abs() < 1e-5 {
-            nodes.pin(i).unwrap();
-        }
-    }
-    (nodes, body)
+    scenes::pinned_beam(length, side, cells, material, model).unwrap()
 }
 
 fn max_speed(n: &Nodes) -> f32 {

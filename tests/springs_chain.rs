@@ -154,17 +154,7 @@ fn a_rope_between_two_pins_hangs_on_the_catenary() {
         .map(|&n| w.get::<Position>(n).unwrap().0.y)
         .fold(f32::INFINITY, f32::min);
     let sag = 3.0 - lowest;
-    // a from L = 2a sinh(S/2a), by bisection (the right side falls as a grows).
-    let (mut lo, mut hi) = (0.05f64, 100.0f64);
-    for _ in 0..200 {
-        let a = 0.5 * (lo + hi);
-        if 2.0 * a * (f64::from(span) / (2.0 * a)).sinh() > f64::from(length) {
-            lo = a;
-        } else {
-            hi = a;
-        }
-    }
-    let a = 0.5 * (lo + hi);
+    let a = hooke::scenes::catenary_parameter(f64::from(span), f64::from(length));
     let c = (f64::from(span) / (2.0 * a)).cosh();
     let closed_sag = (a * (c - 1.0)) as f32;
     // The pinned ends carry half a node's weight each less than the rope's: w per rest length.

@@ -8,7 +8,7 @@ use hooke::ImplicitEuler;
 use hooke::accuracy::{Measurement, Setting, SweepReport, world_for};
 use hooke::prelude::*;
 use hooke::schedule::{ForceSystems, add_force_systems};
-use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+use hooke::soft::{Material, StrainModel};
 
 use crate::problems::Problem;
 
@@ -32,13 +32,7 @@ fn deflection(cells: [usize; 3], model: StrainModel) -> hooke::Result<(f64, f64)
     let mut w = world_for(Setting::new(Integrator::SymplecticEuler, 1), 100.0)?;
     w.insert_resource(Gravity::new(Vec3::ZERO)?);
     let material = Material::new(1e8, 0.0, 1000.0)?;
-    let mesh = TetMesh::cuboid(Vec3::new(1.0, 0.1, 0.1), cells, CellSplit::Six)?;
-    let (mut nodes, body) = SoftBody::build(&mesh, Vec3::new(0.5, 0.0, 0.0), material, model)?;
-    for i in 0..nodes.len() {
-        if nodes.positions()[i].x.abs() < 1e-5 {
-            nodes.pin(i)?;
-        }
-    }
+    let (nodes, body) = hooke::scenes::pinned_beam(1.0, 0.1, cells, material, model)?;
     let tip: Vec<usize> = (0..nodes.len())
         .filter(|&i| (nodes.positions()[i].x - 1.0).abs() < 1e-5)
         .collect();
@@ -129,18 +123,8 @@ pub fn swinging_beam(quick: bool) -> hooke::Result<Problem> {
         w.insert_resource(Gravity::new(Vec3::new(0.0, -9.81, 0.0))?);
         w.resource_mut::<hooke::SleepSettings>().enabled = false;
         let material = Material::new(1e5, 0.3, 1000.0)?;
-        let mesh = TetMesh::cuboid(Vec3::new(1.0, 0.2, 0.2), [5, 1, 1], CellSplit::Six)?;
-        let (mut nodes, body) = SoftBody::build(
-            &mesh,
-            Vec3::new(0.5, 0.0, 0.0),
-            material,
-            StrainModel::Corotated,
-        )?;
-        for i in 0..nodes.len() {
-            if nodes.positions()[i].x.abs() < 1e-5 {
-                nodes.pin(i)?;
-            }
-        }
+        let (nodes, body) =
+            hooke::scenes::pinned_beam(1.0, 0.2, [5, 1, 1], material, StrainModel::Corotated)?;
         let tip = (0..nodes.len())
             .filter(|&i| (nodes.positions()[i].x - 1.0).abs() < 1e-5)
             .collect();

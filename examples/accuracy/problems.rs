@@ -510,17 +510,7 @@ pub fn catenary(quick: bool) -> hooke::Result<Problem> {
         }
         Ok(())
     };
-    // a from L = 2a sinh(S/2a), by bisection.
-    let (mut lo, mut hi) = (0.05f64, 100.0f64);
-    for _ in 0..200 {
-        let a = 0.5 * (lo + hi);
-        if 2.0 * a * (f64::from(span) / (2.0 * a)).sinh() > f64::from(length) {
-            lo = a;
-        } else {
-            hi = a;
-        }
-    }
-    let a = 0.5 * (lo + hi);
+    let a = scenes::catenary_parameter(f64::from(span), f64::from(length));
     let sag = a * ((f64::from(span) / (2.0 * a)).cosh() - 1.0);
     let steps = 900;
     let mut measurements = Vec::new();

@@ -629,9 +629,24 @@ fn correct_contact_settings(
     let ok = |v: f32, finite: bool| v >= 0.0 && (!finite || v.is_finite());
     let fields: [(&'static str, f32, f32, bool); 5] = [
         ("hertz", current.hertz.abs(), d.hertz, true),
-        ("damping_ratio", current.damping_ratio, d.damping_ratio, true),
-        ("max_push_velocity", current.max_push_velocity, d.max_push_velocity, false),
-        ("restitution_threshold", current.restitution_threshold, d.restitution_threshold, false),
+        (
+            "damping_ratio",
+            current.damping_ratio,
+            d.damping_ratio,
+            true,
+        ),
+        (
+            "max_push_velocity",
+            current.max_push_velocity,
+            d.max_push_velocity,
+            false,
+        ),
+        (
+            "restitution_threshold",
+            current.restitution_threshold,
+            d.restitution_threshold,
+            false,
+        ),
         ("margin", current.margin, d.margin, true),
     ];
     let mut fixed = current;
