@@ -30,9 +30,6 @@ pub struct CollisionPlugin;
 impl WorldPlugin for CollisionPlugin {
     fn build(&self, world: &mut World) {
         crate::restore::init::<ContactSettings>(world);
-        crate::quarantine::validate_writes::<super::Friction>(world);
-        crate::quarantine::validate_writes::<super::Restitution>(world);
-        crate::quarantine::validate_writes::<super::RestitutionThreshold>(world);
         add_systems(
             world,
             PhysicsSchedule,
