@@ -165,7 +165,9 @@ type ChangedLive<T> = (Changed<T>, Without<Quarantined>);
 /// Values written through `get_mut` (or any other way past the insert hook): each step,
 /// before anything reads them, every changed `T` is validated as an insert would be, and a
 /// body with a bad value is quarantined. For cold configuration only (materials, damping,
-/// targets): hot state is checked by the integrators' finiteness probes.
+/// targets) that only some bodies carry: a pass over a component every collider requires
+/// would cost every idle body a tick check (materials are checked where contacts read them).
+/// Hot state is checked by the integrators' finiteness probes.
 pub(crate) fn validate_changed<T: Component + Validate>(
     mut commands: Commands,
     changed: Query<(Entity, &T), ChangedLive<T>>,

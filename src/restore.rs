@@ -55,15 +55,19 @@ pub(crate) fn init<T: Resource + Default>(world: &mut World) {
 
 /// Re-creates every missing resource (see the module docs).
 pub(crate) fn restore_resources(world: &mut World) {
-    let Some(restorers) = world.get_resource::<Restorers>().map(|r| r.0.clone()) else {
+    if !world.contains_resource::<Restorers>() {
         return;
-    };
-    let mut restored = Vec::new();
-    for f in restorers {
-        if let Some(name) = f(world) {
-            restored.push(name);
-        }
     }
+    // No allocation in the common case: nothing is missing.
+    let restored = world.resource_scope(|world, restorers: Mut<Restorers>| {
+        let mut restored = Vec::new();
+        for f in &restorers.0 {
+            if let Some(name) = f(world) {
+                restored.push(name);
+            }
+        }
+        restored
+    });
     if !restored.is_empty() {
         restore::<Messages<ResourceRestored>>(world);
         for name in restored {

@@ -351,6 +351,14 @@ fn narrow_body<'a>(
     }
 }
 
+/// Runs a parry call; a panic inside it sets `failed` and gives `None`.
+#[inline]
+fn guarded<T>(failed: &mut bool, f: impl FnOnce() -> T) -> Option<T> {
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).ok();
+    *failed |= r.is_none();
+    r
+}
+
 /// The narrow phase's reused buffers: the bodies of the step's pairs, the pairs' slots
 /// among them, and the point list of the point choice.
 type NarrowBuffers = (Wanted, Vec<(u32, u32)>, Vec<(Vec3A, f32, bool)>);
@@ -401,13 +409,16 @@ fn update_contacts(
         state.sensor = sensor;
         state.cast = None;
         // parry can still panic on shapes at the edge of its domain (EPA's index panic was
-        // seen on huge or badly turned shapes): one bad pair loses its contact and its moving
-        // sides are quarantined, and the step goes on.
-        let found = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        // seen on huge or badly turned shapes): each parry call is guarded, and one bad pair
+        // loses its contact and its moving sides are quarantined while the step goes on.
+        let mut failed = false;
+        let touching = {
             if sensor {
                 let (sa, sb) = (&**ca.collider.shape(), &**cb.collider.shape());
-                parry3d::query::intersection_test(pose_a, sa, pose_b, sb)
-                    .is_ok_and(|i| i.intersecting)
+                guarded(&mut failed, || {
+                    parry3d::query::intersection_test(pose_a, sa, pose_b, sb)
+                })
+                .is_some_and(|r| r.is_ok_and(|i| i.intersecting))
             } else {
                 let prediction = settings.margin + (ca.speed + cb.speed) * dt;
                 let pos12 = pose_a.inverse() * *pose_b;
@@ -426,14 +437,17 @@ fn update_contacts(
                             state.workspace = None;
                         }
                         let reach = prediction + window;
-                        let result = DefaultQueryDispatcher.contact_manifolds(
-                            &pos12,
-                            &**ca.collider.shape(),
-                            &**cb.collider.shape(),
-                            reach,
-                            &mut state.manifolds,
-                            &mut state.workspace,
-                        );
+                        let result = guarded(&mut failed, || {
+                            DefaultQueryDispatcher.contact_manifolds(
+                                &pos12,
+                                &**ca.collider.shape(),
+                                &**cb.collider.shape(),
+                                reach,
+                                &mut state.manifolds,
+                                &mut state.workspace,
+                            )
+                        })
+                        .unwrap_or(Err(parry3d::query::Unsupported));
                         if result.is_err() {
                             state.manifolds.clear();
                         }
@@ -447,14 +461,18 @@ fn update_contacts(
                 let thin = super::ccd::pair_thickness(ca.thin, cb.thin, settings.margin);
                 let sweep = (cb.velocity - ca.velocity).length() + ca.swing.max(cb.swing);
                 if super::ccd::is_fast(sweep, dt, thin) {
-                    state.cast = super::ccd::impact_manifold(
-                        &ca.cast_side(),
-                        &cb.cast_side(),
-                        dt,
-                        thin,
-                        &state.manifolds,
-                        scratch,
-                    )
+                    let manifolds = &state.manifolds;
+                    state.cast = guarded(&mut failed, || {
+                        super::ccd::impact_manifold(
+                            &ca.cast_side(),
+                            &cb.cast_side(),
+                            dt,
+                            thin,
+                            manifolds,
+                            scratch,
+                        )
+                    })
+                    .flatten()
                     .map(Box::new);
                 }
                 state
@@ -463,27 +481,24 @@ fn update_contacts(
                     .flat_map(|m| &m.points)
                     .any(|p| p.dist < touch)
             }
-        }));
-        let touching = match found {
-            Ok(touching) => touching,
-            Err(_) => {
-                state.manifolds.clear();
-                state.workspace = None;
-                state.recycle = None;
-                state.cast = None;
-                for (side, body, other) in [(a, ca, b), (b, cb, a)] {
-                    if body.moving {
-                        commands
-                            .entity(side)
-                            .try_insert(crate::quarantine::Quarantined {
-                                reason: crate::quarantine::QuarantineReason::GeometryFailed {
-                                    other,
-                                },
-                            });
-                    }
+        };
+        let touching = if failed {
+            state.manifolds.clear();
+            state.workspace = None;
+            state.recycle = None;
+            state.cast = None;
+            for (side, body, other) in [(a, ca, b), (b, cb, a)] {
+                if body.moving {
+                    commands
+                        .entity(side)
+                        .try_insert(crate::quarantine::Quarantined {
+                            reason: crate::quarantine::QuarantineReason::GeometryFailed { other },
+                        });
                 }
-                false
             }
+            false
+        } else {
+            touching
         };
         if touching != state.touching {
             state.touching = touching;
