@@ -482,3 +482,61 @@ pub fn catenary_parameter(span: f64, length: f64) -> f64 {
     }
     0.5 * (lo + hi)
 }
+
+/// The DESIGN.md cantilever: a 1 m beam, 0.1 m square, E = 1e8 Pa, ν = 0 (as Euler–Bernoulli
+/// theory assumes), pinned at x = 0, with a 10 N tip load shared by its end nodes and added in
+/// every force evaluation. Beam theory gives a tip deflection F L³ / (3 E I) = 4.000 mm.
+#[derive(Debug, Clone)]
+pub struct Cantilever {
+    /// The beam's entity ([`crate::Nodes`] and [`crate::soft::SoftBody`]).
+    pub body: Entity,
+    /// The end nodes the load is shared by.
+    pub tip: Vec<usize>,
+}
+
+#[derive(Resource, Clone)]
+struct TipLoad(Entity, Vec<usize>, f32);
+
+fn apply_tip_load(load: Res<TipLoad>, mut meshes: Query<&mut crate::Nodes>) {
+    let Ok(mut n) = meshes.get_mut(load.0) else {
+        return;
+    };
+    let each = glam::Vec3A::new(0.0, -load.2 / load.1.len() as f32, 0.0);
+    for &i in &load.1 {
+        let _ = n.add_force(i, each);
+    }
+}
+
+impl Cantilever {
+    /// Spawns the loaded beam, meshed `cells`, with the strain `model` and the implicit
+    /// solver's `settings`. Step the world once with a long dt (100 s) for a static solve.
+    ///
+    /// # Errors
+    /// Mesh errors for bad cell counts.
+    pub fn spawn(
+        world: &mut World,
+        cells: [usize; 3],
+        model: crate::soft::StrainModel,
+        settings: crate::ImplicitEuler,
+    ) -> Result<Self> {
+        let material = crate::soft::Material::new(1e8, 0.0, 1000.0)?;
+        let (nodes, body) = pinned_beam(1.0, 0.1, cells, material, model)?;
+        let tip: Vec<usize> = (0..nodes.len())
+            .filter(|&i| (nodes.positions()[i].x - 1.0).abs() < 1e-5)
+            .collect();
+        let body = world.spawn((nodes, body, settings)).id();
+        world.insert_resource(TipLoad(body, tip.clone(), 10.0));
+        crate::schedule::add_force_systems(world, || {
+            apply_tip_load.in_set(crate::schedule::ForceSystems::User)
+        });
+        Ok(Self { body, tip })
+    }
+
+    /// The mean downward deflection of the end nodes (m), if the beam is still there.
+    #[must_use]
+    pub fn deflection(&self, world: &World) -> Option<f32> {
+        let n = world.get::<crate::Nodes>(self.body)?;
+        let y: f32 = self.tip.iter().map(|&i| n.positions()[i].y).sum();
+        Some(-y / self.tip.len() as f32)
+    }
+}

@@ -2,9 +2,8 @@
 //! cantilever's static deflection against beam theory, with its convergence under refinement.
 
 use bevy_ecs::prelude::*;
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 use hooke::prelude::*;
-use hooke::schedule::{ForceSystems, add_force_systems};
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
 use hooke::{ImplicitEuler, scenes};
 
@@ -87,30 +86,10 @@ fn a_stiff_hanging_beam_is_stable_implicit_at_60_hz_and_diverges_explicit() {
     );
 }
 
-/// A tip load of `load` N shared by the beam's end nodes, added each force evaluation.
-#[derive(Resource, Clone)]
-struct TipLoad(Entity, Vec<usize>, f32);
-
-fn apply_tip_load(load: Res<TipLoad>, mut meshes: Query<&mut Nodes>) {
-    let Ok(mut n) = meshes.get_mut(load.0) else {
-        return;
-    };
-    let each = Vec3A::new(0.0, -load.2 / load.1.len() as f32, 0.0);
-    for &i in &load.1 {
-        n.add_force(i, each).unwrap();
-    }
-}
-
 /// The static tip deflection (m) of a 1 m cantilever, 0.1 m square, E = 1e8, under 10 N.
 fn cantilever(cells: [usize; 3]) -> f32 {
     // One backward-Euler step of 100 s is a static solve: M/h² vanishes beside K.
     let mut w = world(Vec3::ZERO, 100.0, 1);
-    // ν = 0, as Euler–Bernoulli theory (and rapier's cantilever) assume.
-    let material = Material::new(1e8, 0.0, 1000.0).unwrap();
-    let (nodes, body) = beam(1.0, 0.1, cells, material, StrainModel::Corotated);
-    let tip: Vec<usize> = (0..nodes.len())
-        .filter(|&i| (nodes.positions()[i].x - 1.0).abs() < 1e-5)
-        .collect();
     let settings = ImplicitEuler {
         tolerance: 1e-6,
         // Nearly linear: three Newton steps reach the f32 floor of the positions (see the
@@ -119,18 +98,14 @@ fn cantilever(cells: [usize; 3]) -> f32 {
         max_cg: 5000,
         ..ImplicitEuler::default()
     };
-    let e = w.spawn((nodes, body, settings)).id();
-    w.insert_resource(TipLoad(e, tip.clone(), 10.0));
-    add_force_systems(&mut w, || apply_tip_load.in_set(ForceSystems::User));
+    let beam = scenes::Cantilever::spawn(&mut w, cells, StrainModel::Corotated, settings).unwrap();
     w.step_physics();
-    let r = w.get::<SoftBody>(e).unwrap().stats().implicit;
+    let r = w.get::<SoftBody>(beam.body).unwrap().stats().implicit;
     println!(
         "  static solve: {} Newton, {} CG iterations, gradient {:.1e} of the load's",
         r.newton_iterations, r.cg_iterations, r.residual
     );
-    let n = w.get::<Nodes>(e).unwrap();
-    let dy: f32 = tip.iter().map(|&i| n.positions()[i].y).sum::<f32>() / tip.len() as f32;
-    -dy
+    beam.deflection(&w).unwrap()
 }
 
 #[test]

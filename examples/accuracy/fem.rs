@@ -3,27 +3,13 @@
 use std::time::Instant;
 
 use bevy_ecs::prelude::*;
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 use hooke::ImplicitEuler;
 use hooke::accuracy::{Measurement, Setting, SweepReport, world_for};
 use hooke::prelude::*;
-use hooke::schedule::{ForceSystems, add_force_systems};
 use hooke::soft::{Material, StrainModel};
 
 use crate::problems::Problem;
-
-#[derive(Resource)]
-struct TipLoad(Entity, Vec<usize>, f32);
-
-fn apply_tip_load(load: Res<TipLoad>, mut meshes: Query<&mut Nodes>) {
-    let Ok(mut n) = meshes.get_mut(load.0) else {
-        return;
-    };
-    let each = Vec3A::new(0.0, -load.2 / load.1.len() as f32, 0.0);
-    for &i in &load.1 {
-        let _ = n.add_force(i, each);
-    }
-}
 
 /// Tip deflection (m) of a 1 m × 0.1 m × 0.1 m cantilever (E = 1e8 Pa, ν = 0) under a 10 N tip
 /// load, from one backward-Euler step of 100 s (M/h² vanishes beside K: a static solve), and
@@ -31,29 +17,20 @@ fn apply_tip_load(load: Res<TipLoad>, mut meshes: Query<&mut Nodes>) {
 fn deflection(cells: [usize; 3], model: StrainModel) -> hooke::Result<(f64, f64)> {
     let mut w = world_for(Setting::new(Integrator::SymplecticEuler, 1), 100.0)?;
     w.insert_resource(Gravity::new(Vec3::ZERO)?);
-    let material = Material::new(1e8, 0.0, 1000.0)?;
-    let (nodes, body) = hooke::scenes::pinned_beam(1.0, 0.1, cells, material, model)?;
-    let tip: Vec<usize> = (0..nodes.len())
-        .filter(|&i| (nodes.positions()[i].x - 1.0).abs() < 1e-5)
-        .collect();
     let settings = ImplicitEuler {
         tolerance: 1e-6,
         max_newton: 20,
         max_cg: 5000,
         ..ImplicitEuler::default()
     };
-    let e = w.spawn((nodes, body, settings)).id();
-    w.insert_resource(TipLoad(e, tip.clone(), 10.0));
-    add_force_systems(&mut w, || apply_tip_load.in_set(ForceSystems::User));
+    let beam = hooke::scenes::Cantilever::spawn(&mut w, cells, model, settings)?;
     let t0 = Instant::now();
     w.step_physics();
     let spent = t0.elapsed().as_secs_f64();
-    if w.get::<Quarantined>(e).is_some() {
+    if w.get::<Quarantined>(beam.body).is_some() {
         return Ok((f64::NAN, spent));
     }
-    let n = w.get::<Nodes>(e).expect("the beam was spawned");
-    let dy: f32 = tip.iter().map(|&i| n.positions()[i].y).sum::<f32>() / tip.len() as f32;
-    Ok((-f64::from(dy), spent))
+    Ok((beam.deflection(&w).map_or(f64::NAN, f64::from), spent))
 }
 
 pub fn cantilever(quick: bool) -> hooke::Result<Problem> {
