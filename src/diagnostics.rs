@@ -102,7 +102,7 @@ impl PhysicsDiagnostics {
 }
 
 /// What the diagnostics measure.
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DiagnosticsSettings {
     /// Compute energies, momentum and counts every step (one read of every body).
     pub energy: bool,

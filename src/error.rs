@@ -113,6 +113,12 @@ pub enum Error {
         /// The number of nodes.
         len: usize,
     },
+    /// An error read back from a snapshot (the message of the error it was).
+    #[error("{0}")]
+    Restored(String),
+    /// A snapshot could not be read or restored.
+    #[error(transparent)]
+    Snapshot(#[from] crate::snapshot::SnapshotError),
 }
 
 /// Shorthand for hooke results.

@@ -154,6 +154,7 @@ pub mod rigid;
 pub mod scenes;
 pub mod schedule;
 pub mod sleep;
+pub mod snapshot;
 pub mod soft;
 pub mod springs;
 pub mod time;

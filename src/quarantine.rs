@@ -24,12 +24,13 @@ use bevy_ecs::world::DeferredWorld;
 use crate::error::Error;
 
 /// Why a body was taken out of the simulation.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum QuarantineReason {
     /// Its position or velocity became NaN or infinite during a step.
     NonFiniteState,
-    /// A component was inserted with an invalid value.
-    InvalidInput(Error),
+    /// A component was inserted with an invalid value. (Read back from a snapshot, the error
+    /// is an [`Error::Restored`] holding its message.)
+    InvalidInput(#[serde(with = "error_text")] Error),
     /// Its speed (m/s) passed [`DivergenceGuard::max_speed`] while finite: the integration
     /// diverged. For a mesh, `node` is its fastest node.
     Diverged {
@@ -56,7 +57,7 @@ pub enum QuarantineReason {
 
 /// When a finite state counts as diverged (see the module docs). Set a field to
 /// `f32::INFINITY` to turn that check off.
-#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
 pub struct DivergenceGuard {
     /// Speed beyond any body's in a game (m/s; default 1e4, ten times a rifle bullet's).
     pub max_speed: f32,
@@ -98,8 +99,24 @@ impl DivergenceGuard {
     }
 }
 
+/// Errors go into snapshots as their message: several variants hold `&'static str` names.
+mod error_text {
+    use crate::error::Error;
+
+    pub(super) fn serialize<S: serde::Serializer>(e: &Error, s: S) -> Result<S::Ok, S::Error> {
+        match e {
+            Error::Restored(message) => s.serialize_str(message),
+            other => s.serialize_str(&other.to_string()),
+        }
+    }
+
+    pub(super) fn deserialize<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Error, D::Error> {
+        <String as serde::Deserialize>::deserialize(d).map(Error::Restored)
+    }
+}
+
 /// Marks a body that is no longer simulated. See the module docs.
-#[derive(Component, Debug, Clone, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, PartialEq)]
 #[component(on_add = report_quarantine)]
 pub struct Quarantined {
     /// Why.

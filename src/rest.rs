@@ -8,13 +8,19 @@
 use bevy_ecs::prelude::*;
 
 /// Marks a body at rest: no system integrates it until it wakes. See [`crate::sleep`].
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 pub struct Sleeping;
 
 /// Keeps a body from ever sleeping.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 pub struct SleepingDisabled;
 
 /// How long (s) the body has been slower than the sleep thresholds.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
+)]
 pub struct SleepTimer(pub f32);

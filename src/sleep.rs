@@ -36,7 +36,7 @@ use crate::time::PhysicsTime;
 pub use crate::rest::{SleepTimer, Sleeping, SleepingDisabled};
 
 /// When islands fall asleep.
-#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
 pub struct SleepSettings {
     /// Whether bodies may sleep at all.
     pub enabled: bool,

@@ -12,7 +12,7 @@ use crate::error::{Error, Result};
 use crate::schedule::SubstepSchedule;
 
 /// The fixed step and the simulation clock.
-#[derive(Resource, Debug, Clone)]
+#[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone)]
 pub struct PhysicsTime {
     dt: f32,
     substeps: u32,
@@ -153,7 +153,7 @@ impl PhysicsTime {
 }
 
 /// The current substep: its length and start time. Read by time-dependent effects.
-#[derive(Resource, Debug, Clone, Copy, Default)]
+#[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, Default)]
 pub struct SubstepTime {
     /// Substep length h (s).
     pub h: f32,

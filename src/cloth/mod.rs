@@ -40,7 +40,7 @@ use crate::springs::SpringNetwork;
 
 /// A cloth's surface over the [`Nodes`] and [`SpringNetwork`] on the same entity (see the
 /// module docs).
-#[derive(Component, Debug, Clone, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, PartialEq)]
 pub struct Cloth {
     triangles: Vec<[u32; 3]>,
     /// The springs strain limiting holds (the structural ones).
@@ -58,7 +58,7 @@ pub struct Cloth {
 
 /// The springs of a cloth made from triangles: stiffness k (N/m) and damping c (N·s/m) of
 /// each family, and the cloth's areal density (kg/m²).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
 pub struct ClothMaterial {
     /// Areal density ρ (kg/m²); default 0.2 (a cotton sheet).
     pub density: f32,
@@ -266,6 +266,13 @@ impl Cloth {
             .filter_map(|&i| springs.reading(i as usize, nodes))
             .map(|r| r.strain)
             .fold(0.0, f32::max)
+    }
+
+    /// Whether the recorded largest indices are the real ones (see [`Nodes::consistent`]).
+    pub(crate) fn consistent(&self, nodes: usize) -> bool {
+        self.max_corner == self.triangles.iter().flatten().copied().max().unwrap_or(0)
+            && self.max_structural == self.structural.iter().copied().max()
+            && self.contacts.iter().all(|c| (c.node as usize) < nodes)
     }
 
     /// Whether every triangle indexes into `nodes`.

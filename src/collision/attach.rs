@@ -40,7 +40,7 @@ use crate::quarantine::{QuarantineReason, Quarantined, Validate, validate_on_ins
 use crate::rigid::{CenterOfMass, ComputedMass, Inertia, RigidBody, Rotation};
 
 /// Density of a collider (kg/m³), used when hooke computes a body's mass from its colliders.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = density_changed)]
 pub struct ColliderDensity(pub f32);
 
@@ -76,7 +76,7 @@ fn density_changed(mut world: DeferredWorld, ctx: HookContext) {
 
 /// Where a child collider sits in its parent's frame (m and a unit quaternion). With the
 /// `bevy` feature hooke writes it from the child's `Transform`.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = offset_changed)]
 pub struct ColliderOffset {
     /// Translation in the parent's frame (m).
@@ -125,7 +125,7 @@ fn offset_changed(mut world: DeferredWorld, ctx: HookContext) {
 
 /// Set by hooke on a child collider that is part of the body `body`. The child's own
 /// [`Position`] and [`Rotation`] follow the body; the collision systems see only the body.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = attachment_changed, on_remove = attachment_changed)]
 pub struct ColliderOf {
     /// The body this collider is part of.
@@ -152,7 +152,7 @@ fn attachment_changed(mut world: DeferredWorld, ctx: HookContext) {
 }
 
 /// The body's own collider while its [`Collider`] holds the compound of all its parts.
-#[derive(Component, Clone)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Clone)]
 pub(crate) struct OwnShape(Collider);
 
 /// The body a collider on `entity` belongs to: `entity` itself if it is a body, else the

@@ -174,7 +174,9 @@ impl RigidSide {
 /// start of the next one, before its integrator and its rigid contacts: its velocity at the
 /// end of a step is then what its rigid contacts left (a crate under a jelly reads at rest),
 /// and whatever holds it up answers the push in the same substep.
-#[derive(Component, Debug, Clone, Copy, Default, PartialEq)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, Default, PartialEq,
+)]
 pub(crate) struct NodeImpulse {
     /// N·s, world frame.
     pub(crate) linear: Vec3,

@@ -66,10 +66,23 @@ mod prepare;
 mod query;
 mod solver;
 
+pub(crate) use attach::OwnShape;
 pub use attach::{ColliderDensity, ColliderOf, ColliderOffset};
+pub(crate) use coupling::NodeImpulse;
+pub(crate) use narrow::ContactsRecord;
 pub use narrow::{ContactPair, Contacts};
 pub use plugin::CollisionPlugin;
 pub(crate) use plugin::shape_pose;
+
+/// Makes the broad phase rebuild both its lists at the next step (its output, the sorted
+/// set of overlapping pairs, does not depend on their history): what a restored snapshot
+/// needs instead of the lists themselves.
+pub(crate) fn rebuild_broad_phase(world: &mut World) {
+    if let Some(mut bp) = world.get_resource_mut::<broad::BroadPhase>() {
+        bp.fixed_dirty = true;
+        bp.moving_dirty = true;
+    }
+}
 pub use query::{Hit, Projection, QueryFilter, SpatialQuery};
 
 use bevy_ecs::prelude::*;
@@ -85,7 +98,8 @@ use crate::rigid::Rotation;
 
 /// A collision shape (a parry shape) attached to a body, placed at the body's shape frame:
 /// origin x − R c, where c is the [`crate::CenterOfMass`].
-#[derive(Component, Clone)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Clone)]
+#[serde(try_from = "ColliderRecord", into = "ColliderRecord")]
 #[require(
     Position,
     Rotation,
@@ -103,6 +117,40 @@ pub struct Collider {
     bounds: [Vec3; 2],
     /// Built by hooke from a body's parts (see the `attach` module), not by the user.
     composed: bool,
+}
+
+/// A collider as a snapshot holds it: the shape, checked again on the way back in (by
+/// [`Collider::new`]: a shape edited by hand must still be one parry handles).
+#[derive(serde::Serialize, serde::Deserialize)]
+struct ColliderRecord {
+    shape: SharedShape,
+    composed: bool,
+}
+
+impl From<Collider> for ColliderRecord {
+    fn from(c: Collider) -> Self {
+        Self {
+            shape: c.shape,
+            composed: c.composed,
+        }
+    }
+}
+
+impl TryFrom<ColliderRecord> for Collider {
+    type Error = Error;
+
+    fn try_from(r: ColliderRecord) -> Result<Self> {
+        // A malformed composite (a mesh index past its vertices) can panic inside parry.
+        let built =
+            std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| Collider::new(r.shape)))
+                .map_err(|_| {
+                    Error::Restored("the collider's shape made the geometry library fail".into())
+                })??;
+        Ok(Self {
+            composed: r.composed,
+            ..built
+        })
+    }
 }
 
 impl std::fmt::Debug for Collider {
@@ -390,7 +438,7 @@ fn positive_len(what: &'static str, v: f32) -> Result<f32> {
 }
 
 /// Coulomb friction coefficient μ (dimensionless, default 0.5).
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct Friction(pub f32);
 
@@ -407,7 +455,9 @@ impl Validate for Friction {
 }
 
 /// Coefficient of restitution e in [0, 1] (default 0: no bounce).
-#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
+)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct Restitution(pub f32);
 
@@ -429,7 +479,7 @@ impl Validate for Restitution {
 /// with one each, the contact takes the lower. A small threshold lets slow impacts bounce
 /// too (a ball's bounce series goes on longer); too small, and a resting body jitters on the
 /// bounces of its own settling.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct RestitutionThreshold(pub f32);
 
@@ -440,7 +490,7 @@ impl Validate for RestitutionThreshold {
 }
 
 /// How two colliders' coefficients combine into one for their contact.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum CombineRule {
     /// √(a b): the default for friction.
     #[default]
@@ -471,7 +521,7 @@ impl CombineRule {
 
 /// Which colliders may touch: a pair interacts when each one's `memberships` meets the
 /// other's `filters`. Default: every layer, colliding with every layer.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct CollisionLayers {
     /// Layers this collider is on (bit mask).
     pub memberships: u32,
@@ -498,12 +548,16 @@ impl CollisionLayers {
 
 /// Marks a collider that reports overlaps (through [`Contacts`] and the contact messages)
 /// without pushing anything.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 pub struct Sensor;
 
 /// The world bounding box of a collider as of the last step (m), grown by its speculative
 /// margin.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
+)]
 pub struct ColliderAabb {
     /// Lower corner.
     pub min: Vec3,
@@ -512,7 +566,7 @@ pub struct ColliderAabb {
 }
 
 /// Contact solver settings (Box2D v3's, except for the stiffness cap; see [`ContactSettings::hertz`]).
-#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
 pub struct ContactSettings {
     /// Stiffness of the soft contact, as a frequency (Hz), capped at an eighth of the
     /// substep rate: 30 Hz with 4 substeps at 60 Hz, the full 60 Hz from 8 substeps. A stack
@@ -598,7 +652,9 @@ pub struct ContactEnd {
 
 /// Opts a body in to the [`ContactStart`] and [`ContactEnd`] entity events (messages are
 /// written for every pair regardless). Opt-in, so a world that observes nothing pays nothing.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 pub struct CollisionEventsEnabled;
 
 /// Written when two colliders stop touching (or are despawned while touching).

@@ -9,7 +9,7 @@ use parry3d::query::{ContactManifold, ContactManifoldsWorkspace};
 
 /// What each contact point carries from step to step: its accumulated normal impulse, for
 /// warm starting. parry moves it to the matching point of the next step's manifold.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct ContactImpulse {
     /// Normal impulse (N·s).
     pub normal: f32,
@@ -18,7 +18,7 @@ pub(crate) struct ContactImpulse {
 /// What a manifold carries from step to step: its friction impulses, for warm starting, and
 /// which of its points the solver takes (chosen when its points are found, see
 /// [`choose_points`]).
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct ManifoldData {
     /// Friction impulse at the manifold's centre (N·s, world frame).
     pub tangent: Vec3,
@@ -62,7 +62,7 @@ pub(crate) struct PairState {
 /// growth of the prediction stays within `window`. The drift bounds how far any point of
 /// the second shape moved in the first shape's frame: |Δt| + 2 |sin(Δθ/2)| r for a shape
 /// within r of its origin.
-#[derive(Debug, Clone, Copy)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy)]
 pub(crate) struct Recycle {
     /// The second shape's pose in the first's frame.
     pub pos12: Pose,
@@ -414,5 +414,106 @@ mod tests {
         // holds the closest features of then, not every feature within that reach: past
         // the window it is found again.
         assert!(!reach(10.0).holds(&now, extent, prediction, bound - 1e-5));
+    }
+}
+
+/// One pair's state as a snapshot holds it (see [`crate::snapshot`]).
+#[derive(Clone, serde::Serialize, serde::Deserialize)]
+pub(crate) struct PairRecord {
+    a: Entity,
+    b: Entity,
+    manifolds: Vec<Manifold>,
+    workspace: Option<ContactManifoldsWorkspace>,
+    touching: bool,
+    sensor: bool,
+    seen: u64,
+    recycle: Option<Recycle>,
+    cast: Option<Manifold>,
+}
+
+/// [`Contacts`] as a snapshot holds it: the pairs in key order, so that the same contacts
+/// always write the same bytes.
+#[derive(Clone, Default, serde::Serialize, serde::Deserialize)]
+pub(crate) struct ContactsRecord {
+    pairs: Vec<PairRecord>,
+    step: u64,
+    woken: Vec<(Entity, Entity)>,
+}
+
+/// Whether every point a manifold's data names is one of its points (the solver indexes by
+/// them).
+fn kept_in_range(m: &Manifold) -> bool {
+    usize::from(m.data.kept_len) <= MAX_POINTS
+        && m.data
+            .kept()
+            .iter()
+            .all(|&k| usize::from(k) < m.points.len())
+}
+
+impl Contacts {
+    /// The pairs and their warm-start impulses, for a snapshot.
+    pub(crate) fn to_record(&self) -> ContactsRecord {
+        let mut pairs: Vec<PairRecord> = self
+            .pairs
+            .iter()
+            .map(|(&(a, b), s)| PairRecord {
+                a,
+                b,
+                manifolds: s.manifolds.clone(),
+                workspace: s.workspace.clone(),
+                touching: s.touching,
+                sensor: s.sensor,
+                seen: s.seen,
+                recycle: s.recycle,
+                cast: s.cast.as_deref().cloned(),
+            })
+            .collect();
+        pairs.sort_unstable_by_key(|p| (p.a, p.b));
+        ContactsRecord {
+            pairs,
+            step: self.step,
+            woken: self.woken.clone(),
+        }
+    }
+
+    /// Contacts from a snapshot, their entities mapped by `map`. `Err` names an entity the
+    /// map does not know, or (`None`) a manifold whose data points past its points.
+    pub(crate) fn from_record(
+        record: ContactsRecord,
+        map: impl Fn(Entity) -> Option<Entity>,
+    ) -> Result<Self, Option<Entity>> {
+        let both = |(a, b): (Entity, Entity)| {
+            Ok::<_, Option<Entity>>(key(map(a).ok_or(Some(a))?, map(b).ok_or(Some(b))?))
+        };
+        let mut pairs = HashMap::default();
+        pairs.reserve(record.pairs.len());
+        for p in record.pairs {
+            if !p.manifolds.iter().chain(&p.cast).all(kept_in_range) {
+                return Err(None);
+            }
+            let k = both((p.a, p.b))?;
+            pairs.insert(
+                k,
+                PairState {
+                    manifolds: p.manifolds,
+                    workspace: p.workspace,
+                    touching: p.touching,
+                    sensor: p.sensor,
+                    seen: p.seen,
+                    recycle: p.recycle,
+                    cast: p.cast.map(Box::new),
+                },
+            );
+        }
+        let woken = record
+            .woken
+            .into_iter()
+            .map(both)
+            .collect::<Result<_, _>>()?;
+        Ok(Self {
+            pairs,
+            step: record.step,
+            woken,
+        })
     }
 }

@@ -30,7 +30,7 @@ use crate::particles::Nodes;
 
 /// A plane n·x ≥ offset a node may not cross during the solve (a contact with a static or
 /// kinematic collider, moving with it over the substep).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
 pub(crate) struct ContactPlane {
     pub node: u32,
     pub normal: Vec3,
@@ -87,7 +87,7 @@ pub(crate) trait ImplicitElements {
 }
 
 /// What one implicit substep did.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Default)]
 pub struct ImplicitReport {
     /// Newton iterations taken.
     pub newton_iterations: u32,

@@ -53,7 +53,9 @@ use glam::Vec3A;
 
 /// Which time integrator advances bodies. A resource (the default for every body) and, through
 /// [`IntegratorOverride`], a per-body choice.
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Hash, Default,
+)]
 pub enum Integrator {
     /// Forward Euler. First order; energy grows every step. For teaching and comparison.
     ExplicitEuler,
@@ -156,7 +158,7 @@ impl Integrator {
 /// first order and damps: an undamped oscillator loses the factor 1/(1 + ω²h²) of its energy
 /// per step. Put it on an entity beside the mesh ([`crate::soft::SoftBody`]); the constant
 /// forces of the step (gravity, external, damping) enter as f_ext.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[require(ImplicitState)]
 pub struct ImplicitEuler {
     /// Newton stops when the gradient's norm has fallen below this fraction of the step's
@@ -184,7 +186,7 @@ pub struct ImplicitEuler {
 
 /// What the implicit solve keeps from one step to the next for one body (the preconditioner's
 /// factor); added with [`ImplicitEuler`], nothing to set.
-#[derive(Component, Debug, Clone, Default)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Default)]
 pub struct ImplicitState {
     pub(crate) factor: Option<skyline::SkylineCholesky>,
     /// (nodes, elements) the factor's pattern was built for; `None` before the first build.
@@ -220,7 +222,7 @@ impl Default for ImplicitEuler {
 
 /// Marks an [`ImplicitEuler`] that [`Integrator::ImplicitEuler`] (the global dial) put on a
 /// mesh, so that leaving the dial takes it off again.
-#[derive(Component, Debug, Clone, Copy, Default)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, Default)]
 pub(crate) struct ImplicitByDial;
 
 /// While the global [`Integrator`] is [`Integrator::ImplicitEuler`], gives every mesh with an
@@ -250,7 +252,7 @@ pub(crate) fn follow_implicit_dial<M: Component>(
 }
 
 /// Per-body override of the global [`Integrator`].
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct IntegratorOverride(pub Integrator);
 
 /// One explicit Euler step: both updates use the start-of-step state.

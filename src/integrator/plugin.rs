@@ -21,7 +21,9 @@ use crate::{SubstepSchedule, WorldPlugin};
 /// [`crate::PhysicsSystems::Prepare`]. While it is false nothing runs between the velocity and
 /// the position half of symplectic Euler, so particles take both halves in one pass: the same
 /// arithmetic, bit for bit, with one read of memory instead of two.
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 pub struct ConstraintsActive(pub bool);
 
 impl ConstraintsActive {

@@ -86,7 +86,7 @@ pub(crate) fn reverse_cuthill_mckee(adjacency: &[Vec<u32>]) -> Vec<u32> {
 }
 
 /// L of A = L Lᵀ over 3 × 3 node blocks, in the RCM order, stored by rows of its envelope.
-#[derive(Debug, Clone, Default)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Default)]
 pub(crate) struct SkylineCholesky {
     /// `order[k]`: the node whose three unknowns are rows 3k..3k+3.
     order: Vec<u32>,

@@ -18,7 +18,7 @@ use glam::{Vec3, Vec3A};
 use crate::error::{Result, finite, finite_vec};
 
 /// Uniform gravitational acceleration (m/s²). Default: (0, −9.81, 0).
-#[derive(Resource, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
 pub struct Gravity(Vec3);
 
 impl Default for Gravity {
@@ -49,7 +49,9 @@ impl Gravity {
 }
 
 /// How tracers integrate dx/dt = u(x, t).
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 pub enum Advection {
     /// x ← x + h u(x, t): the lecture's scheme, first order.
     #[default]
@@ -63,7 +65,7 @@ pub enum Advection {
 type FieldFn = dyn Fn(Vec3, f32) -> Vec3 + Send + Sync;
 
 /// A velocity field u(x, t) (m/s). Put it on an entity; tracers feel the sum of all fields.
-#[derive(Component, Clone)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Clone)]
 pub enum VelocityField {
     /// The same velocity everywhere.
     Uniform(Vec3),
@@ -74,7 +76,9 @@ pub enum VelocityField {
         /// Angular velocity ω (rad/s); its direction is the axis.
         omega: Vec3,
     },
-    /// Any function of position (m) and time (s) giving m/s.
+    /// Any function of position (m) and time (s) giving m/s. (A closure: snapshots refuse
+    /// it.)
+    #[serde(skip)]
     Custom(Arc<FieldFn>),
 }
 

@@ -34,7 +34,7 @@ use crate::quarantine::{Validate, validate_on_insert};
 macro_rules! finite_vec_component {
     ($(#[$doc:meta])* $name:ident($ty:ty), $what:literal) => {
         $(#[$doc])*
-        #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+        #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default)]
         #[component(on_insert = validate_on_insert::<Self>)]
         pub struct $name(pub $ty);
 
@@ -94,12 +94,14 @@ finite_vec_component!(
 /// The force accumulator (N): reset to [`ExternalForce`] (or zero) at the start of every
 /// force evaluation, then every effect adds into it. Read it after a step to see the forces
 /// of the last evaluation. `Vec3A`, like [`Position`].
-#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
+)]
 pub struct Force(pub Vec3A);
 
 /// Mass (kg), stored with its inverse. An infinite mass pins the body: forces don't move it,
 /// but a velocity you give it does (a kinematic particle).
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[require(Position, LinearVelocity, Force)]
 pub struct Mass {
     /// m, or 0 for pinned bodies so that m·g and m·c·v vanish without a branch.
@@ -159,7 +161,7 @@ impl Mass {
 }
 
 /// Multiplies gravity for one body (dimensionless; 1 by default, 0 to float).
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct GravityScale(pub f32);
 
@@ -176,7 +178,9 @@ impl Validate for GravityScale {
 }
 
 /// Linear drag coefficient c (1/s): f = −c m v, so velocity decays like e^(−c t).
-#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
+)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct LinearDamping(pub f32);
 
@@ -187,7 +191,9 @@ impl Validate for LinearDamping {
 }
 
 /// A massless particle advected by velocity fields.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 #[require(Position)]
 pub struct Tracer;
 

@@ -11,7 +11,7 @@ use crate::error::{Error, Result, finite_vec};
 /// [`crate::springs::SpringNetwork`] on the same entity.
 ///
 /// Units as for particles: positions in m, velocities in m/s, masses in kg, forces in N.
-#[derive(Component, Debug, Clone, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Default, PartialEq)]
 pub struct Nodes {
     pub(crate) x: Vec<Vec3A>,
     pub(crate) v: Vec<Vec3A>,
@@ -22,6 +22,20 @@ pub struct Nodes {
 }
 
 impl Nodes {
+    /// Whether the arrays agree in length (they can disagree only in data read from a
+    /// snapshot written by hand).
+    pub(crate) fn consistent(&self) -> bool {
+        let n = self.x.len();
+        [
+            self.v.len(),
+            self.f.len(),
+            self.mass.len(),
+            self.inv_mass.len(),
+        ]
+        .iter()
+        .all(|&l| l == n)
+    }
+
     /// No nodes.
     #[must_use]
     pub fn new() -> Self {

@@ -220,7 +220,7 @@ impl RigidBodyBundle {
 
 /// Mass properties hooke computed for a body (from its colliders, or the default for a
 /// body with none); a [`Mass`] of a different value is the user's and is left alone.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 pub(crate) struct ComputedMass {
     pub(crate) mass: f32,
 }

@@ -62,7 +62,9 @@ use crate::quarantine::{Validate, validate_on_insert};
 /// use [`RigidBodyBundle`]). Inserting another kind later changes the body: kinematic
 /// bodies get infinite mass and inertia, static bodies lose their mass and velocity
 /// components.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 #[require(Position, Rotation)]
 #[cfg_attr(feature = "bevy", require(bevy_transform::components::Transform))]
 #[component(on_insert = mass::body_kind_changed)]
@@ -77,7 +79,7 @@ pub enum RigidBody {
 }
 
 /// Orientation q, a unit quaternion from body to world frame.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct Rotation(pub Quat);
 
@@ -124,7 +126,7 @@ impl Rotation {
 macro_rules! angular_vec {
     ($(#[$doc:meta])* $name:ident, $what:literal) => {
         $(#[$doc])*
-        #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+        #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default)]
         #[component(on_insert = validate_on_insert::<Self>)]
         pub struct $name(pub Vec3A);
 
@@ -167,17 +169,21 @@ angular_vec!(
 );
 
 /// The torque accumulator τ (N·m, world frame), like [`crate::Force`].
-#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
+)]
 pub struct Torque(pub Vec3A);
 
 /// Centre of mass in the body's shape frame (m). The frame origin in the world is x − R c.
-#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
+)]
 pub struct CenterOfMass(pub Vec3);
 
 /// The body-frame inertia tensor I₀ = F diag(p) Fᵀ, stored by its principal moments p
 /// (kg·m²) and principal frame F, with the inverse moments. Infinite moments (inverse 0)
 /// make a body that torques cannot turn.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[require(AngularMomentum, AngularVelocity, Torque, Rotation)]
 pub struct Inertia {
     principal: Vec3A,
@@ -329,7 +335,9 @@ fn unit(q: Quat) -> Quat {
 
 /// How [`Rotation`] advances over a step (for the Euler and Verlet integrators; RK4 always
 /// integrates q̇ = ½ ω ⊗ q at its stages).
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 pub enum OrientationUpdate {
     /// Free-rotation splitting (the default): the kinetic energy Σ Lᵢ²/2Iᵢ is split into
     /// three spins about the principal axes, each solved exactly (L fixed in the world, the
@@ -348,7 +356,7 @@ pub enum OrientationUpdate {
 }
 
 /// Whether the renormalise set restores |q| = 1 every substep (default: on).
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Renormalization(pub bool);
 
 impl Default for Renormalization {
@@ -358,12 +366,14 @@ impl Default for Renormalization {
 }
 
 /// Opts one body out of renormalisation (to show the drift it prevents).
-#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 pub struct SkipRenormalization;
 
 /// A force applied at a point, every step until changed or removed: adds f to the force
 /// and (p − x) × f to the torque.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct ExternalForceAtPoint {
     /// Force (N, world frame).
@@ -383,7 +393,7 @@ impl Validate for ExternalForceAtPoint {
 
 /// A one-shot impulse J (N·s, world frame) at a point: Δv = J/m, ΔL = (p − x) × J at the
 /// next substep, then the impulse is reset to zero (like [`crate::ExternalImpulse`]).
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct ExternalImpulseAtPoint {
     /// Impulse (N·s, world frame).
@@ -402,7 +412,9 @@ impl Validate for ExternalImpulseAtPoint {
 }
 
 /// Angular drag coefficient c (1/s): τ = −c L, so spin decays like e^(−c t).
-#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
+)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct AngularDamping(pub f32);
 
@@ -414,7 +426,7 @@ impl Validate for AngularDamping {
 
 /// A pose a kinematic body should reach by the end of each step: hooke sets its velocities
 /// to (target − x)/dt and the rotation difference over dt.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct KinematicTarget {
     /// Target centre-of-mass position (m).

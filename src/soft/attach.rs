@@ -49,12 +49,12 @@ pub const MAX_ATTACHED_NODES: usize = 128;
 /// (its offset in the body's frame), and both sides exchange impulses from then on (see the
 /// module docs). Pinned nodes are skipped; a missing or quarantined body leaves its nodes
 /// free until it is back.
-#[derive(Component, Debug, Clone, Default)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Default)]
 pub struct NodeAttachments {
     links: Vec<Link>,
 }
 
-#[derive(Debug, Clone)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone)]
 struct Link {
     body: Entity,
     nodes: Vec<u32>,
@@ -68,6 +68,20 @@ struct Link {
 }
 
 impl NodeAttachments {
+    /// The bodies attached, for a snapshot to map onto its restored entities.
+    pub(crate) fn bodies_mut(&mut self) -> impl Iterator<Item = &mut Entity> {
+        self.links.iter_mut().map(|l| &mut l.body)
+    }
+
+    /// Whether every link indexes into a mesh of `nodes` nodes and has a local point per
+    /// node once set (see [`crate::Nodes`]).
+    pub(crate) fn fits(&self, nodes: usize) -> bool {
+        self.links.iter().all(|l| {
+            l.nodes.iter().all(|&i| (i as usize) < nodes)
+                && (l.local.is_empty() || l.local.len() == l.nodes.len())
+        })
+    }
+
     /// Attachments to one body: `nodes` are node indices of this entity's mesh.
     ///
     /// # Errors

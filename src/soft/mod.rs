@@ -51,7 +51,7 @@ use crate::error::{Error, Result, finite, non_negative, positive};
 use crate::particles::Nodes;
 
 /// The Lamé parameters μ (shear modulus) and λ (Pa).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
 pub struct Lame {
     /// μ (Pa).
     pub mu: f32,
@@ -61,7 +61,7 @@ pub struct Lame {
 
 /// An isotropic elastic material: Young's modulus, Poisson's ratio, density and Rayleigh
 /// damping.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
 pub struct Material {
     young: f32,
     poisson: f32,
@@ -143,7 +143,7 @@ impl Material {
 }
 
 /// What a soft body's last force evaluation found: elastic energy, volume and inversion.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Default)]
 pub struct SoftBodyStats {
     /// Elastic energy Σ V Ψ(F) (J).
     pub elastic_energy: f32,
@@ -160,7 +160,7 @@ pub struct SoftBodyStats {
 /// (positions, velocities, forces, inverse lumped masses), so gravity, damping, velocity
 /// fields, every integrator and the quarantine act on its nodes as on any mesh. Spawn both
 /// with [`SoftBody::build`].
-#[derive(Component, Debug, Clone, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, PartialEq)]
 #[require(Nodes)]
 pub struct SoftBody {
     tets: Vec<[u32; 4]>,
@@ -246,6 +246,15 @@ impl SoftBody {
             contacts: Vec::new(),
         };
         Ok((nodes, body))
+    }
+
+    /// Whether every element has its rest data and indexes into `nodes` (see
+    /// [`Nodes::consistent`]).
+    pub(crate) fn fits(&self, nodes: usize) -> bool {
+        self.dm_inv.len() == self.tets.len()
+            && self.volume.len() == self.tets.len()
+            && self.tets.iter().flatten().all(|&i| (i as usize) < nodes)
+            && self.contacts.iter().all(|c| (c.node as usize) < nodes)
     }
 
     /// How far from a collider's surface its nodes are kept (m; default 5 mm).

@@ -14,7 +14,7 @@ use crate::time::PhysicsTime;
 /// targeted node is pinned (infinite mass: the mesh cannot push it) and given the velocity
 /// (target − x)/dt, so it arrives at the end of the step under any integrator, explicit or
 /// implicit. Removing the component, or a node's target, gives the node its mass back.
-#[derive(Component, Debug, Clone, PartialEq, Default)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, PartialEq, Default)]
 #[component(on_remove = release_all)]
 pub struct NodeTargets {
     targets: Vec<(u32, Vec3)>,
@@ -23,6 +23,15 @@ pub struct NodeTargets {
 }
 
 impl NodeTargets {
+    /// Whether every node index is within a mesh of `nodes` nodes.
+    pub(crate) fn fits(&self, nodes: usize) -> bool {
+        self.targets
+            .iter()
+            .map(|t| t.0)
+            .chain(self.held.iter().map(|h| h.0))
+            .all(|i| (i as usize) < nodes)
+    }
+
     /// Targets for `(node, position)` pairs.
     ///
     /// # Errors

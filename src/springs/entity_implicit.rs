@@ -94,9 +94,16 @@ pub(crate) struct EntitySolve {
     ends: Vec<End>,
     index: HashMap<(Entity, [u32; 3]), u32>,
     anchors_per_body: HashMap<Entity, u32>,
+    scratch: Scratch<SpringNetwork>,
+}
+
+/// What the entity-spring solve keeps from one step to the next: the preconditioner's factor
+/// and the topology it was built for. A resource, not the system's scratch, so that a
+/// snapshot carries it (a restored world that refactored would round differently).
+#[derive(Resource, Debug, Clone, Default, serde::Serialize, serde::Deserialize)]
+pub(crate) struct EntitySpringFactor {
     last_ends: Vec<[u32; 2]>,
     state: ImplicitState,
-    scratch: Scratch<SpringNetwork>,
 }
 
 impl EntitySolve {
@@ -157,7 +164,9 @@ pub(crate) fn solve_entity_springs(
     mut forces: Query<&mut Force, Live>,
     mut torques: Query<&mut Torque, Live>,
     mut solve: Local<EntitySolve>,
+    mut kept: ResMut<EntitySpringFactor>,
 ) {
+    let kept = &mut *kept;
     let global = *global;
     let s = &mut *solve;
     s.clear();
@@ -252,24 +261,24 @@ pub(crate) fn solve_entity_springs(
         s.nodes.inv_mass.push(if m > 0.0 { 1.0 / m } else { 0.0 });
         s.nodes.f.push(f_ext);
     }
-    if s.network.ends != s.last_ends || s.state.built_for.map(|k| k.0) != Some(s.ends.len()) {
+    if s.network.ends != kept.last_ends || kept.state.built_for.map(|k| k.0) != Some(s.ends.len()) {
         // A new topology needs a new envelope for the factor.
-        s.state = ImplicitState::default();
-        s.last_ends.clone_from(&s.network.ends);
+        kept.state = ImplicitState::default();
+        kept.last_ends.clone_from(&s.network.ends);
     }
     let settings = settings.unwrap_or_default();
     let report = step(
         &mut s.network,
         &mut s.nodes,
         &settings,
-        &mut s.state,
+        &mut kept.state,
         h,
         &mut s.scratch,
     );
     let failure = match report {
         None => Some((QuarantineReason::NonFiniteState, None)),
         Some(report) => {
-            s.state.last = report;
+            kept.state.last = report;
             crate::integrator::mesh_divergence(&s.nodes, &guard).map(|reason| {
                 let node = match reason {
                     QuarantineReason::Diverged {

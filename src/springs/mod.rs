@@ -38,6 +38,7 @@ pub mod stability;
 
 pub(crate) use builders::MAX_BUILDER_NODES;
 pub use builders::{Chain, ChainBuilder};
+pub(crate) use entity_implicit::EntitySpringFactor;
 pub use plugin::SpringPlugin;
 pub(crate) use plugin::{Endpoint, Spinning, anchor_state};
 pub use stability::{EntitySpringStability, SpringStability, StabilityPolicy, StabilityWarning};
@@ -89,7 +90,7 @@ pub fn spring_energy(xa: Vec3A, xb: Vec3A, rest: f32, k: f32) -> f32 {
 ///
 /// Build it with [`Spring::new`] or [`Spring::from_hooke`] and spawn it like any component.
 /// If an endpoint is despawned, the spring is despawned at the next step.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = validate_spring)]
 pub struct Spring {
     a: Entity,
@@ -102,6 +103,11 @@ pub struct Spring {
 }
 
 impl Spring {
+    /// The two endpoints, for a snapshot to map onto its restored entities.
+    pub(crate) fn ends_mut(&mut self) -> [&mut Entity; 2] {
+        [&mut self.a, &mut self.b]
+    }
+
     /// The lecture's spring: rest length `r` (m, > 0), `ks` (N per unit strain) and `kd`
     /// (N·s per unit strain rate).
     ///
@@ -271,7 +277,7 @@ impl SpringReading {
 }
 
 /// Springs between the [`Nodes`] of the same entity, as parallel arrays (Hooke form).
-#[derive(Component, Debug, Clone, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Default, PartialEq)]
 #[require(SpringStability)]
 pub struct SpringNetwork {
     pub(crate) ends: Vec<[u32; 2]>,
@@ -286,6 +292,17 @@ pub struct SpringNetwork {
 }
 
 impl SpringNetwork {
+    /// Whether the arrays agree and `max_index` is the largest endpoint (see
+    /// [`Nodes::consistent`]).
+    pub(crate) fn consistent(&self) -> bool {
+        let n = self.ends.len();
+        let max = self.ends.iter().flatten().copied().max().unwrap_or(0);
+        [self.rest.len(), self.k.len(), self.c.len()]
+            .iter()
+            .all(|&l| l == n)
+            && (n == 0 || max == self.max_index)
+    }
+
     /// No springs.
     #[must_use]
     pub fn new() -> Self {

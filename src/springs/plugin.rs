@@ -49,6 +49,7 @@ impl WorldPlugin for SpringPlugin {
                 .in_set(crate::schedule::ImplicitSystems::Springs),
         );
         crate::restore::init::<super::EntitySpringStability>(world);
+        crate::restore::init::<super::entity_implicit::EntitySpringFactor>(world);
         crate::restore::init::<super::StabilityPolicy>(world);
         crate::restore::init::<bevy_ecs::message::Messages<super::StabilityWarning>>(world);
         add_systems(

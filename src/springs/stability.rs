@@ -40,7 +40,9 @@ use crate::particles::{Mass, Nodes};
 use crate::time::PhysicsTime;
 
 /// A [`SpringNetwork`] mesh's explicit stability limit (see the module docs).
-#[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
+)]
 pub struct SpringStability {
     /// The largest stable substep h_crit (s); infinite for springs between pinned nodes only.
     pub critical_step: f32,
@@ -51,7 +53,9 @@ pub struct SpringStability {
 }
 
 /// The entity springs' shared stability limit (see the module docs).
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Default,
+)]
 pub struct EntitySpringStability {
     /// The largest stable substep over all [`Spring`] entities (s).
     pub critical_step: f32,
@@ -66,7 +70,9 @@ pub struct EntitySpringStability {
 
 /// What hooke does with a spring system whose explicit stability limit is below the substep
 /// (see [`crate::springs::stability`]). A resource.
-#[derive(Resource, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Default,
+)]
 pub enum StabilityPolicy {
     /// Solve it with backward Euler from then on ([`ImplicitEuler`] is inserted on it), and
     /// write a [`StabilityWarning`] saying so. The default.

@@ -1,0 +1,416 @@
+//! The component columns of a snapshot: one list of `(entity slot, value)` per component
+//! type, in slot order, generated for every type a step reads.
+
+use bevy_ecs::bundle::BundleScratch;
+use bevy_ecs::change_detection::{DetectChangesMut, MAX_CHANGE_AGE, Tick};
+use bevy_ecs::component::{Component, ComponentId, Mutable};
+use bevy_ecs::prelude::*;
+use bevy_platform::collections::HashMap;
+use serde::{Deserialize, Serialize};
+
+use super::SnapshotError;
+use crate::error::Error;
+use crate::quarantine::Validate;
+
+/// What a snapshot does with each component type beyond storing it: check a value read
+/// back (a file may be edited by hand), and map the entities it names onto the restored
+/// ones.
+pub(crate) trait Column: Component + Clone + Serialize + for<'de> Deserialize<'de> {
+    /// Checks a value read from a snapshot.
+    fn check(&self) -> Result<(), Error> {
+        Ok(())
+    }
+
+    /// The entities the value names.
+    fn entities_mut(&mut self) -> Vec<&mut Entity> {
+        Vec::new()
+    }
+
+    /// Writes `value` over `id`'s, unmarked, with change ticks as old as `old`. (Nothing for
+    /// an immutable component: inserted once, no hook recomputes it.)
+    fn settle(_world: &mut World, _id: Entity, _value: &Self, _old: Tick) {}
+}
+
+fn settle_mut<T: Component<Mutability = Mutable> + Clone>(
+    world: &mut World,
+    id: Entity,
+    value: &T,
+    old: Tick,
+) {
+    if let Some(mut c) = world.get_mut::<T>(id) {
+        *c.bypass_change_detection() = value.clone();
+        c.set_last_changed(old);
+        c.set_last_added(old);
+    }
+}
+
+macro_rules! settled {
+    () => {
+        fn settle(world: &mut World, id: Entity, value: &Self, old: Tick) {
+            settle_mut(world, id, value, old);
+        }
+    };
+}
+
+macro_rules! plain {
+    ($($ty:ty),* $(,)?) => { $(impl Column for $ty { settled!(); })* };
+}
+
+macro_rules! validated {
+    ($($ty:ty),* $(,)?) => {
+        $(impl Column for $ty {
+            fn check(&self) -> Result<(), Error> {
+                Validate::validate(self)
+            }
+            settled!();
+        })*
+    };
+}
+
+use crate::cloth::Cloth;
+use crate::collision::ColliderAabb;
+use crate::collision::{NodeImpulse, OwnShape};
+use crate::integrator::ImplicitByDial;
+use crate::rest::{SleepTimer, Sleeping, SleepingDisabled};
+use crate::rigid::ComputedMass;
+use crate::soft::{NodeAttachments, NodeTargets, SoftBody};
+use crate::*;
+use core::result::Result;
+
+validated!(
+    Position,
+    LinearVelocity,
+    ExternalForce,
+    ExternalImpulse,
+    GravityScale,
+    LinearDamping,
+    Friction,
+    Restitution,
+    RestitutionThreshold,
+    ColliderDensity,
+    ColliderOffset,
+    Rotation,
+    AngularVelocity,
+    AngularMomentum,
+    ExternalTorque,
+    ExternalForceAtPoint,
+    ExternalImpulseAtPoint,
+    AngularDamping,
+    KinematicTarget,
+);
+plain!(
+    Force,
+    Tracer,
+    VelocityField,
+    SpringNetwork,
+    SpringStability,
+    Collider,
+    CollisionLayers,
+    Sensor,
+    ColliderAabb,
+    CollisionEventsEnabled,
+    OwnShape,
+    NodeImpulse,
+    Sleeping,
+    SleepingDisabled,
+    SleepTimer,
+    ImplicitEuler,
+    ImplicitState,
+    ImplicitByDial,
+    IntegratorOverride,
+    Cloth,
+    SoftBody,
+    NodeTargets,
+    ComputedMass,
+    Torque,
+    CenterOfMass,
+    Inertia,
+    SkipRenormalization,
+    RigidBody,
+);
+
+impl Column for Mass {
+    settled!();
+
+    fn check(&self) -> Result<(), Error> {
+        if self.is_pinned() {
+            Ok(())
+        } else {
+            Mass::new(self.value()).map(|_| ())
+        }
+    }
+}
+
+impl Column for Nodes {
+    settled!();
+
+    fn check(&self) -> Result<(), Error> {
+        if self.consistent() {
+            Ok(())
+        } else {
+            Err(Error::Restored(
+                "mesh node arrays of different lengths".into(),
+            ))
+        }
+    }
+}
+
+impl Column for Spring {
+    settled!();
+
+    fn entities_mut(&mut self) -> Vec<&mut Entity> {
+        self.ends_mut().into()
+    }
+}
+
+impl Column for ColliderOf {
+    settled!();
+
+    fn entities_mut(&mut self) -> Vec<&mut Entity> {
+        vec![&mut self.body]
+    }
+}
+
+impl Column for ChildOf {
+    fn entities_mut(&mut self) -> Vec<&mut Entity> {
+        vec![&mut self.0]
+    }
+}
+
+impl Column for NodeAttachments {
+    settled!();
+
+    fn entities_mut(&mut self) -> Vec<&mut Entity> {
+        self.bodies_mut().collect()
+    }
+}
+
+impl Column for Quarantined {
+    // The entities a reason names are for reading only: one that is gone stays as it was.
+    settled!();
+}
+
+/// Maps an entity of the captured world onto the restored one.
+pub(crate) type Map = HashMap<Entity, Entity>;
+
+/// Ticks older than any system's last run: restored values are not "changed" (a step would
+/// otherwise take every restored value for a write by game code, and wake sleepers, resync
+/// ω from L, recompute manifolds).
+pub(crate) fn ancient(world: &World) -> Tick {
+    Tick::new(world.read_change_tick().get().wrapping_sub(MAX_CHANGE_AGE))
+}
+
+fn map_all<T: Column>(value: &mut T, map: &Map, lenient: bool) -> Result<(), Entity> {
+    for e in value.entities_mut() {
+        match map.get(e) {
+            Some(&to) => *e = to,
+            None if lenient => {}
+            None => return Err(*e),
+        }
+    }
+    Ok(())
+}
+
+macro_rules! columns {
+    ($($field:ident: $ty:ty),* $(,)?) => {
+        /// One column per component type.
+        #[derive(Clone, Default, Serialize, Deserialize)]
+        pub(crate) struct Columns {
+            $(
+                #[serde(default)]
+                $field: Vec<(u32, $ty)>,
+            )*
+        }
+
+        impl Columns {
+            /// The component ids of every type in the columns that `world` knows.
+            pub(crate) fn component_ids(world: &World) -> Vec<ComponentId> {
+                [$(world.component_id::<$ty>()),*].into_iter().flatten().collect()
+            }
+
+            /// Every value of every column type on the entities of `slots`.
+            pub(crate) fn capture(world: &World, slots: &HashMap<Entity, u32>) -> Self {
+                let mut columns = Self::default();
+                $(
+                    if let Some(mut q) = world.try_query::<(Entity, &$ty)>() {
+                        columns.$field.extend(
+                            q.iter(world).filter_map(|(e, v)| Some((*slots.get(&e)?, v.clone()))),
+                        );
+                        columns.$field.sort_by_key(|(slot, _)| *slot);
+                    }
+                )*
+                columns
+            }
+
+            /// Checks every value, that every slot is one of `len` and holds a type once, and
+            /// maps the entities the values name.
+            pub(crate) fn check_and_map(&mut self, len: usize, map: &Map) -> Result<(), SnapshotError> {
+                $(
+                    let mut last = None;
+                    for (slot, value) in &mut self.$field {
+                        let component = stringify!($ty);
+                        if *slot as usize >= len || last.is_some_and(|l| l >= *slot) {
+                            return Err(SnapshotError::BadSlot { component, slot: *slot, len });
+                        }
+                        last = Some(*slot);
+                        value.check().map_err(|e| SnapshotError::Invalid {
+                            slot: *slot,
+                            component,
+                            error: e.to_string(),
+                        })?;
+                        let lenient = component == "Quarantined";
+                        map_all(value, map, lenient).map_err(|target| SnapshotError::Dangling {
+                            slot: *slot,
+                            component,
+                            target,
+                        })?;
+                    }
+                )*
+                Ok(())
+            }
+
+            /// The values of one slot, for the checks across components of an entity.
+            pub(crate) fn nodes_of(&self) -> HashMap<u32, usize> {
+                self.nodes.iter().map(|(slot, n)| (*slot, n.len())).collect()
+            }
+
+            /// Spawns every slot's components on `ids[slot]` as one bundle each, in slot
+            /// order, so that the restored entities sit in the captured storage order.
+            #[allow(unsafe_code)]
+            pub(crate) fn write(&self, world: &mut World, ids: &[Entity]) {
+                let mut scratch = BundleScratch::default();
+                $(let mut $field = self.$field.iter().peekable();)*
+                for (slot, &id) in ids.iter().enumerate() {
+                    let slot = slot as u32;
+                    let mut writer = scratch.writer();
+                    $(
+                        if let Some((_, value)) = $field.next_if(|(s, _)| *s == slot) {
+                            // SAFETY: every component is registered with and written to this
+                            // one world.
+                            unsafe { writer.push_component(&mut world.components_registrator(), value.clone()) };
+                        }
+                    )*
+                    let mut entity = world.entity_mut(id);
+                    // SAFETY: as above, `entity` is of the world the components came from.
+                    unsafe { writer.write(&mut entity) };
+                }
+            }
+
+            /// Writes every value again, unmarked, over what the insert hooks' commands may
+            /// have recomputed (in a different rounding), and ages every restored value's
+            /// change ticks (see [`ancient`]).
+            pub(crate) fn settle(&self, world: &mut World, ids: &[Entity]) {
+                let old = ancient(world);
+                $(
+                    for (slot, value) in &self.$field {
+                        <$ty as Column>::settle(world, ids[*slot as usize], value, old);
+                    }
+                )*
+            }
+        }
+    };
+}
+
+columns!(
+    position: Position,
+    linear_velocity: LinearVelocity,
+    external_force: ExternalForce,
+    external_impulse: ExternalImpulse,
+    force: Force,
+    mass: Mass,
+    gravity_scale: GravityScale,
+    linear_damping: LinearDamping,
+    tracer: Tracer,
+    velocity_field: VelocityField,
+    nodes: Nodes,
+    spring: Spring,
+    spring_network: SpringNetwork,
+    spring_stability: SpringStability,
+    rigid_body: RigidBody,
+    rotation: Rotation,
+    angular_velocity: AngularVelocity,
+    angular_momentum: AngularMomentum,
+    external_torque: ExternalTorque,
+    torque: Torque,
+    center_of_mass: CenterOfMass,
+    inertia: Inertia,
+    computed_mass: ComputedMass,
+    skip_renormalization: SkipRenormalization,
+    external_force_at_point: ExternalForceAtPoint,
+    external_impulse_at_point: ExternalImpulseAtPoint,
+    angular_damping: AngularDamping,
+    kinematic_target: KinematicTarget,
+    collider: Collider,
+    friction: Friction,
+    restitution: Restitution,
+    restitution_threshold: RestitutionThreshold,
+    collision_layers: CollisionLayers,
+    sensor: Sensor,
+    collider_aabb: ColliderAabb,
+    collision_events_enabled: CollisionEventsEnabled,
+    collider_density: ColliderDensity,
+    collider_offset: ColliderOffset,
+    collider_of: ColliderOf,
+    own_shape: OwnShape,
+    node_impulse: NodeImpulse,
+    child_of: ChildOf,
+    sleeping: Sleeping,
+    sleeping_disabled: SleepingDisabled,
+    sleep_timer: SleepTimer,
+    implicit_euler: ImplicitEuler,
+    implicit_state: ImplicitState,
+    implicit_by_dial: ImplicitByDial,
+    integrator_override: IntegratorOverride,
+    cloth: Cloth,
+    soft_body: SoftBody,
+    node_targets: NodeTargets,
+    node_attachments: NodeAttachments,
+    quarantined: Quarantined,
+);
+
+impl Columns {
+    /// The checks that span components of one entity: a mesh's elements, springs and
+    /// attachments must index into its nodes.
+    pub(crate) fn check_meshes(&self) -> Result<(), SnapshotError> {
+        let nodes = self.nodes_of();
+        let len = |slot: &u32| nodes.get(slot).copied().unwrap_or(0);
+        let bad = |slot: u32, component: &'static str| SnapshotError::Invalid {
+            slot,
+            component,
+            error: "indexes past the entity's mesh nodes".into(),
+        };
+        for (slot, s) in &self.spring_network {
+            if !s.consistent() || !(s.is_empty() || (s.max_index as usize) < len(slot)) {
+                return Err(bad(*slot, "SpringNetwork"));
+            }
+        }
+        for (slot, c) in &self.cloth {
+            if !c.consistent(len(slot)) {
+                return Err(bad(*slot, "Cloth"));
+            }
+        }
+        for (slot, s) in &self.soft_body {
+            if !s.fits(len(slot)) {
+                return Err(bad(*slot, "SoftBody"));
+            }
+        }
+        for (slot, t) in &self.node_targets {
+            if !t.fits(len(slot)) {
+                return Err(bad(*slot, "NodeTargets"));
+            }
+        }
+        for (slot, a) in &self.node_attachments {
+            if !a.fits(len(slot)) {
+                return Err(bad(*slot, "NodeAttachments"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether any velocity field is a closure (which cannot be saved).
+    pub(crate) fn has_custom_field(&self) -> bool {
+        self.velocity_field
+            .iter()
+            .any(|(_, f)| matches!(f, VelocityField::Custom(_)))
+    }
+}
