@@ -31,6 +31,14 @@ pub enum QuarantineReason {
     /// A component was inserted with an invalid value. (Read back from a snapshot, the error
     /// is an [`Error::Restored`] holding its message.)
     InvalidInput(#[serde(with = "error_text")] Error),
+    /// Its position passed [`DivergenceGuard::max_distance`] from the origin while finite (a
+    /// body flung that far in one step by a pass whose velocity the next pass undid).
+    OutOfBounds {
+        /// The largest coordinate (m).
+        distance: f32,
+        /// The mesh node, for a [`crate::Nodes`] mesh.
+        node: Option<u32>,
+    },
     /// Its speed (m/s) passed [`DivergenceGuard::max_speed`] while finite: the integration
     /// diverged. For a mesh, `node` is its fastest node.
     Diverged {
@@ -64,6 +72,15 @@ pub struct DivergenceGuard {
     /// Spring strain |l − r| / r beyond any rope's (dimensionless; default 100: a spring
     /// stretched to 101 times its rest length). Zero-length springs are not checked.
     pub max_spring_strain: f32,
+    /// Distance from the origin along any axis beyond any game world's (m; default 1e6,
+    /// [`crate::Collider::MAX_EXTENT`]: f32 resolves positions there to 6 cm). The fuzzer found
+    /// a body flung to 2e8 m within one step at a speed the step's last pass had undone.
+    #[serde(default = "far")]
+    pub max_distance: f32,
+}
+
+fn far() -> f32 {
+    1e6
 }
 
 impl Default for DivergenceGuard {
@@ -71,6 +88,7 @@ impl Default for DivergenceGuard {
         Self {
             max_speed: 1e4,
             max_spring_strain: 100.0,
+            max_distance: far(),
         }
     }
 }
@@ -91,9 +109,31 @@ impl DivergenceGuard {
         }
     }
 
-    /// The reason for a finite body moving at `v`, if it diverged.
+    /// The position half of the probe: x · scale overflows when |x| > max_distance on an
+    /// axis (1 when the check is off).
     #[must_use]
-    pub(crate) fn check(&self, v: glam::Vec3A, node: Option<u32>) -> Option<QuarantineReason> {
+    #[inline]
+    pub(crate) fn distance_scale(&self) -> f32 {
+        let d = self.max_distance;
+        if d.is_finite() && d > 0.0 {
+            f32::MAX / d
+        } else {
+            1.0
+        }
+    }
+
+    /// The reason for a finite body at `x` moving at `v`, if it diverged or left the world.
+    #[must_use]
+    pub(crate) fn check(
+        &self,
+        x: glam::Vec3A,
+        v: glam::Vec3A,
+        node: Option<u32>,
+    ) -> Option<QuarantineReason> {
+        let distance = x.abs().max_element();
+        if distance > self.max_distance {
+            return Some(QuarantineReason::OutOfBounds { distance, node });
+        }
         let speed = v.length();
         (speed > self.max_speed).then_some(QuarantineReason::Diverged { speed, node })
     }

@@ -182,6 +182,57 @@ pub(crate) fn queue_refresh_owner(world: &mut DeferredWorld, entity: Entity) {
     }
 }
 
+/// The body `entity`'s collider belongs to, refreshed (see [`queue_refresh_owner`]).
+fn refresh_owner_of(world: &mut World, entity: Entity) {
+    let body = owner(world, entity).or_else(|| world.get::<ColliderOf>(entity).map(|c| c.body));
+    if let Some(body) = body {
+        refresh_body(world, body);
+    }
+}
+
+type WrittenPart<'a> = (
+    Entity,
+    Option<Ref<'a, ColliderDensity>>,
+    Option<Ref<'a, ColliderOffset>>,
+);
+
+type WrittenFilter = (
+    Or<(Changed<ColliderDensity>, Changed<ColliderOffset>)>,
+    Without<Quarantined>,
+);
+
+/// A density or offset written through `get_mut` (past the insert hook) is checked as an
+/// insert would be, and its body's mass and compound are rebuilt: before, such a write was
+/// silently ignored (the body kept its old mass) and a NaN one was never reported. Values
+/// just inserted were handled by the hook.
+pub(crate) fn refresh_written_parts(
+    mut commands: Commands,
+    parts: Query<WrittenPart, WrittenFilter>,
+) {
+    for (e, density, offset) in &parts {
+        let written = |r: Option<bool>| r.unwrap_or(false);
+        let d = written(density.as_ref().map(|d| d.is_changed() && !d.is_added()));
+        let o = written(offset.as_ref().map(|o| o.is_changed() && !o.is_added()));
+        if !(d || o) {
+            continue;
+        }
+        let bad = [
+            density.filter(|_| d).and_then(|v| v.validate().err()),
+            offset.filter(|_| o).and_then(|v| v.validate().err()),
+        ]
+        .into_iter()
+        .flatten()
+        .next();
+        if let Some(err) = bad {
+            commands.entity(e).try_insert(Quarantined {
+                reason: QuarantineReason::InvalidInput(err),
+            });
+        } else {
+            commands.queue(move |world: &mut World| refresh_owner_of(world, e));
+        }
+    }
+}
+
 /// Observer: a body was spawned or changed kind.
 pub(crate) fn on_body_inserted(event: On<Insert<RigidBody>>, mut commands: Commands) {
     let body = event.event().entity;

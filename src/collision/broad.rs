@@ -27,7 +27,7 @@ use super::CollisionLayers;
 use super::lanes::F4;
 
 /// One collider's box as the broad phase sees it.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]
 pub(crate) struct Entry {
     pub entity: Entity,
     pub min: Vec3,
@@ -318,6 +318,57 @@ impl BroadPhase {
         }
         self.pairs.sort_unstable();
         self.pairs.dedup();
+    }
+}
+
+/// The broad phase as a snapshot holds it: the moving boxes as kept (grown, possibly from
+/// earlier steps: the pairs they give are a superset that depends on history) in their sweep
+/// order, the sweep axes and the last pairs. The fixed list and its tree are rebuilt (their
+/// pairs do not depend on history).
+#[derive(Clone, Default, serde::Serialize, serde::Deserialize)]
+pub(crate) struct BroadPhaseRecord {
+    moving: Vec<Entry>,
+    moving_dirty: bool,
+    axis: usize,
+    cell_axis: usize,
+    pairs: Vec<(Entity, Entity)>,
+}
+
+impl BroadPhase {
+    /// What a snapshot keeps (see [`BroadPhaseRecord`]).
+    pub(crate) fn to_record(&self) -> BroadPhaseRecord {
+        BroadPhaseRecord {
+            moving: self.moving.clone(),
+            moving_dirty: self.moving_dirty,
+            axis: self.axis,
+            cell_axis: self.cell_axis,
+            pairs: self.pairs.clone(),
+        }
+    }
+
+    /// Restores a record, its entities mapped by `map` (an order-keeping map: the lists
+    /// stay sorted). `Err` names an entity the map does not know.
+    pub(crate) fn restore(
+        &mut self,
+        record: &BroadPhaseRecord,
+        map: impl Fn(Entity) -> Option<Entity>,
+    ) -> Result<(), Entity> {
+        let mut moving = record.moving.clone();
+        for e in &mut moving {
+            e.entity = map(e.entity).ok_or(e.entity)?;
+        }
+        let pairs = record
+            .pairs
+            .iter()
+            .map(|&(a, b)| Ok(key(map(a).ok_or(a)?, map(b).ok_or(b)?)))
+            .collect::<Result<Vec<_>, Entity>>()?;
+        self.moving = moving;
+        self.moving_dirty = record.moving_dirty;
+        self.axis = record.axis.min(2);
+        self.cell_axis = record.cell_axis.min(2);
+        self.pairs = pairs;
+        self.fixed_dirty = true;
+        Ok(())
     }
 }
 

@@ -74,13 +74,31 @@ pub use narrow::{ContactPair, Contacts};
 pub use plugin::CollisionPlugin;
 pub(crate) use plugin::shape_pose;
 
-/// Makes the broad phase rebuild both its lists at the next step (its output, the sorted
-/// set of overlapping pairs, does not depend on their history): what a restored snapshot
-/// needs instead of the lists themselves.
-pub(crate) fn rebuild_broad_phase(world: &mut World) {
-    if let Some(mut bp) = world.get_resource_mut::<broad::BroadPhase>() {
-        bp.fixed_dirty = true;
-        bp.moving_dirty = true;
+pub(crate) use broad::BroadPhaseRecord;
+
+/// The broad phase's kept state, for a snapshot.
+pub(crate) fn broad_phase_record(world: &World) -> Option<BroadPhaseRecord> {
+    world
+        .get_resource::<broad::BroadPhase>()
+        .map(broad::BroadPhase::to_record)
+}
+
+/// Restores the broad phase from a snapshot's record (or, with none, has it rebuild).
+pub(crate) fn restore_broad_phase(
+    world: &mut World,
+    record: Option<&BroadPhaseRecord>,
+    map: impl Fn(Entity) -> Option<Entity>,
+) -> Result<(), Entity> {
+    let Some(mut bp) = world.get_resource_mut::<broad::BroadPhase>() else {
+        return Ok(());
+    };
+    match record {
+        Some(r) => bp.restore(r, map),
+        None => {
+            bp.fixed_dirty = true;
+            bp.moving_dirty = true;
+            Ok(())
+        }
     }
 }
 pub use query::{Hit, Projection, QueryFilter, SpatialQuery};

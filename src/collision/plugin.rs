@@ -33,7 +33,11 @@ impl WorldPlugin for CollisionPlugin {
         add_systems(
             world,
             PhysicsSchedule,
-            correct_contact_settings.in_set(crate::schedule::PrepareSystems::Inputs),
+            (
+                correct_contact_settings,
+                super::attach::refresh_written_parts,
+            )
+                .in_set(crate::schedule::PrepareSystems::Inputs),
         );
         crate::restore::init::<super::ColliderChanges>(world);
         crate::restore::init::<BroadPhase>(world);
@@ -630,10 +634,15 @@ fn relax_contacts(
 fn correct_contact_settings(
     mut settings: ResMut<ContactSettings>,
     mut invalid: MessageWriter<crate::restore::InvalidSetting>,
+    mut bp: ResMut<BroadPhase>,
 ) {
     if !settings.is_changed() {
         return;
     }
+    // The boxes are grown by the margin: fixed colliders' boxes are only recomputed when
+    // the lists are rebuilt (a new margin left them at the old one).
+    bp.fixed_dirty = true;
+    bp.moving_dirty = true;
     let d = ContactSettings::default();
     let current = *settings;
     // (`recycle_distance` and `max_rotation` are left alone: negative or NaN documentedly

@@ -93,6 +93,7 @@ impl Side {
             friction.validate().err(),
             restitution.validate().err(),
             threshold.and_then(|t| t.validate().err()),
+            com.and_then(|c| c.validate().err()),
         ]
         .into_iter()
         .flatten()

@@ -211,11 +211,11 @@ fn integrate_velocities(
         // Speed is checked in the step's last substep only: the multiply costs 6% of this
         // loop, and a divergence is still caught in the step it happens.
         if time.index + 1 >= time.count {
-            let s = guard.overflow_scale();
+            let (s, sx) = (guard.overflow_scale(), guard.distance_scale());
             set.p0().iter_mut().for_each(|(mut x, mut v, f, m)| {
                 let va = kick(v.0, f.0 * m.inverse(), h);
                 let xa = drift(x.0, va, h);
-                probe += (xa + va * s) * 0.0;
+                probe += (xa * sx + va * s) * 0.0;
                 v.0 = va;
                 x.0 = xa;
             });
@@ -280,7 +280,7 @@ fn quarantine_suspects(commands: &mut Commands, suspects: &Suspects, guard: &Div
     for (e, x, v) in suspects {
         if !(x.0.is_finite() && v.0.is_finite()) {
             quarantine_non_finite(commands, e);
-        } else if let Some(reason) = guard.check(v.0, None) {
+        } else if let Some(reason) = guard.check(x.0, v.0, None) {
             commands.entity(e).insert(Quarantined { reason });
         }
     }
@@ -296,9 +296,23 @@ fn check_mesh(commands: &mut Commands, e: Entity, n: &Nodes, guard: &DivergenceG
     }
 }
 
-/// Why a finite mesh counts as diverged: its fastest node is past the guard.
+/// Why a finite mesh counts as diverged: its farthest node left the world, or its fastest
+/// node is past the guard.
 #[must_use]
 pub(crate) fn mesh_divergence(n: &Nodes, guard: &DivergenceGuard) -> Option<QuarantineReason> {
+    let (far, distance) =
+        n.x.iter()
+            .enumerate()
+            .fold((0, 0.0f32), |(bi, bd), (i, x)| {
+                let d = x.abs().max_element();
+                if d > bd { (i, d) } else { (bi, bd) }
+            });
+    if distance > guard.max_distance {
+        return Some(QuarantineReason::OutOfBounds {
+            distance,
+            node: Some(far as u32),
+        });
+    }
     let (i, _) =
         n.v.iter()
             .enumerate()
@@ -306,7 +320,7 @@ pub(crate) fn mesh_divergence(n: &Nodes, guard: &DivergenceGuard) -> Option<Quar
                 let s = v.length_squared();
                 if s > bs { (i, s) } else { (bi, bs) }
             });
-    guard.check(*n.v.get(i)?, Some(i as u32))
+    guard.check(glam::Vec3A::ZERO, *n.v.get(i)?, Some(i as u32))
 }
 
 #[allow(clippy::type_complexity)] // a ParamSet of queries; naming each adds nothing
@@ -330,10 +344,10 @@ fn integrate_positions(
     // Speed folded into the finiteness probe (see `DivergenceGuard::overflow_scale`).
     let mut probe = Vec3A::ZERO;
     // In the step's last substep only (see `integrate_velocities`).
-    let s = if time.index + 1 >= time.count {
-        guard.overflow_scale()
+    let (s, sx) = if time.index + 1 >= time.count {
+        (guard.overflow_scale(), guard.distance_scale())
     } else {
-        0.0
+        (0.0, 1.0)
     };
     if constraints.fuses(method) {
         // Done in the velocity pass.
@@ -344,7 +358,7 @@ fn integrate_positions(
         bodies.p0().iter_mut().for_each(|(mut x, v)| {
             let (xa, va) = (x.0, v.0);
             let xa = drift(xa, va, h);
-            probe += (xa + va * s) * 0.0;
+            probe += (xa * sx + va * s) * 0.0;
             x.0 = xa;
         });
     } else if method == Integrator::ExplicitEuler {
@@ -352,7 +366,7 @@ fn integrate_positions(
         bodies
             .p0()
             .iter()
-            .for_each(|(x, v)| probe += (x.0 + v.0 * s) * 0.0);
+            .for_each(|(x, v)| probe += (x.0 * sx + v.0 * s) * 0.0);
     }
     bodies.p1().iter_mut().for_each(|((mut x, v), o)| {
         if matches!(
@@ -361,7 +375,7 @@ fn integrate_positions(
         ) {
             x.0 = drift(x.0, v.0, h);
         }
-        probe += (x.0 + v.0 * s) * 0.0;
+        probe += (x.0 * sx + v.0 * s) * 0.0;
     });
     if probe != Vec3A::ZERO {
         quarantine_suspects(&mut commands, &bodies.p2(), &guard);
@@ -372,7 +386,7 @@ fn integrate_positions(
         let mut probe = Vec3A::ZERO;
         for (x, v) in n.x.iter_mut().zip(&n.v) {
             position_phase(method, x, *v, h);
-            probe += (*x + *v * s) * 0.0;
+            probe += (*x * sx + *v * s) * 0.0;
         }
         if probe != Vec3A::ZERO {
             check_mesh(&mut commands, e, n, &guard);

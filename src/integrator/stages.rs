@@ -291,7 +291,7 @@ pub(crate) fn complete_stages(
         if let Ok((_, x, v, ..)) = bodies.get(world, *e) {
             if !(x.0.is_finite() && v.0.is_finite()) {
                 bad.push((*e, QuarantineReason::NonFiniteState));
-            } else if let Some(reason) = guard.check(v.0, None) {
+            } else if let Some(reason) = guard.check(x.0, v.0, None) {
                 bad.push((*e, reason));
             }
         }

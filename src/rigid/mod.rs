@@ -175,10 +175,18 @@ angular_vec!(
 pub struct Torque(pub Vec3A);
 
 /// Centre of mass in the body's shape frame (m). The frame origin in the world is x − R c.
+/// Checked on insert, and where contacts read it (a non-finite one quarantines its body).
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[component(on_insert = validate_on_insert::<Self>)]
 pub struct CenterOfMass(pub Vec3);
+
+impl Validate for CenterOfMass {
+    fn validate(&self) -> Result<()> {
+        finite_vec("center of mass", self.0).map(|_| ())
+    }
+}
 
 /// The body-frame inertia tensor I₀ = F diag(p) Fᵀ, stored by its principal moments p
 /// (kg·m²) and principal frame F, with the inverse moments. Infinite moments (inverse 0)

@@ -97,6 +97,7 @@ validated!(
     ExternalImpulseAtPoint,
     AngularDamping,
     KinematicTarget,
+    CenterOfMass,
 );
 plain!(
     Force,
@@ -123,7 +124,6 @@ plain!(
     NodeTargets,
     ComputedMass,
     Torque,
-    CenterOfMass,
     Inertia,
     SkipRenormalization,
     RigidBody,
@@ -245,6 +245,9 @@ macro_rules! columns {
             /// Checks every value, that every slot is one of `len` and holds a type once, and
             /// maps the entities the values name.
             pub(crate) fn check_and_map(&mut self, len: usize, map: &Map) -> Result<(), SnapshotError> {
+                // A quarantined body keeps the bad value that put it there; it is restored
+                // quarantined, and no system reads it.
+                let quarantined: Vec<u32> = self.quarantined.iter().map(|(slot, _)| *slot).collect();
                 $(
                     let mut last = None;
                     for (slot, value) in &mut self.$field {
@@ -253,11 +256,13 @@ macro_rules! columns {
                             return Err(SnapshotError::BadSlot { component, slot: *slot, len });
                         }
                         last = Some(*slot);
-                        value.check().map_err(|e| SnapshotError::Invalid {
-                            slot: *slot,
-                            component,
-                            error: e.to_string(),
-                        })?;
+                        if quarantined.binary_search(slot).is_err() {
+                            value.check().map_err(|e| SnapshotError::Invalid {
+                                slot: *slot,
+                                component,
+                                error: e.to_string(),
+                            })?;
+                        }
                         let lenient = component == "Quarantined";
                         map_all(value, map, lenient).map_err(|target| SnapshotError::Dangling {
                             slot: *slot,
@@ -274,14 +279,19 @@ macro_rules! columns {
                 self.nodes.iter().map(|(slot, n)| (*slot, n.len())).collect()
             }
 
-            /// Spawns every slot's components on `ids[slot]` as one bundle each, in slot
-            /// order, so that the restored entities sit in the captured storage order.
+            /// Spawns the components of every slot `include` takes on `ids[slot]` as one
+            /// bundle each, in slot order, so that the restored entities sit in the captured
+            /// storage order.
             #[allow(unsafe_code)]
-            pub(crate) fn write(&self, world: &mut World, ids: &[Entity]) {
+            pub(crate) fn write(&self, world: &mut World, ids: &[Entity], include: impl Fn(u32) -> bool) {
                 let mut scratch = BundleScratch::default();
                 $(let mut $field = self.$field.iter().peekable();)*
                 for (slot, &id) in ids.iter().enumerate() {
                     let slot = slot as u32;
+                    if !include(slot) {
+                        $(while $field.next_if(|(s, _)| *s == slot).is_some() {})*
+                        continue;
+                    }
                     let mut writer = scratch.writer();
                     $(
                         if let Some((_, value)) = $field.next_if(|(s, _)| *s == slot) {
@@ -405,6 +415,12 @@ impl Columns {
             }
         }
         Ok(())
+    }
+
+    /// Whether `slot` holds a spring (written after every body, so that its insert hook
+    /// finds both ends).
+    pub(crate) fn spring_slots(&self) -> Vec<u32> {
+        self.spring.iter().map(|(slot, _)| *slot).collect()
     }
 
     /// Whether any velocity field is a closure (which cannot be saved).

@@ -36,8 +36,9 @@
 //! **What is in one.** Every hooke component of every entity that has one (bodies, springs,
 //! meshes, colliders and their parts, sleep and quarantine markers, the implicit solver's
 //! kept factor), the parent links of child colliders, the settings and clock resources, and
-//! the contact manifolds with their warm-start impulses. The broad phase is not stored: its
-//! output is the sorted set of overlapping boxes, which a rebuild finds again exactly.
+//! the contact manifolds with their warm-start impulses, and the broad phase's kept boxes (it
+//! keeps a grown box while the collider stays inside it, so its candidate pairs depend on
+//! history; the fixed colliders' tree is rebuilt, their pairs do not).
 //! Not stored: game components, Bevy's `Transform` (re-derived from the pose), messages in
 //! flight, and [`crate::VelocityField::Custom`] (a closure: [`Snapshot::capture`] refuses it).
 //!
@@ -226,6 +227,7 @@ pub struct Snapshot {
     columns: Columns,
     resources: Resources,
     contacts: Option<ContactsRecord>,
+    broad_phase: Option<crate::collision::BroadPhaseRecord>,
     /// Colliders changed since the last step (the next step wakes what touched them).
     collider_changes: Vec<Entity>,
 }
@@ -302,6 +304,7 @@ impl Snapshot {
             columns,
             resources: Resources::capture(world),
             contacts: world.get_resource::<Contacts>().map(Contacts::to_record),
+            broad_phase: crate::collision::broad_phase_record(world),
             collider_changes: world
                 .get_resource::<ColliderChanges>()
                 .map(|c| c.entities().to_vec())
@@ -371,7 +374,10 @@ impl Snapshot {
             // Allocated just above and never spawned, so this cannot fail.
             let _ = world.spawn_empty_at(id);
         }
-        columns.write(world, &ids);
+        let springs = columns.spring_slots();
+        let is_spring = |slot: u32| springs.binary_search(&slot).is_ok();
+        columns.write(world, &ids, |slot| !is_spring(slot));
+        columns.write(world, &ids, is_spring);
         // The insert hooks queued their bookkeeping (mass from colliders, compound parts).
         world.flush();
         columns.settle(world, &ids);
@@ -394,7 +400,10 @@ impl Snapshot {
                 .filter_map(|e| map.get(e).copied())
                 .collect();
         }
-        crate::collision::rebuild_broad_phase(world);
+        // Entities the checks above found in the map: the broad phase names only colliders.
+        let _ = crate::collision::restore_broad_phase(world, self.broad_phase.as_ref(), |e| {
+            map.get(&e).copied()
+        });
         Ok(EntityMap(map))
     }
 
