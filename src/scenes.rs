@@ -540,3 +540,50 @@ impl Cantilever {
         Some(-y / self.tip.len() as f32)
     }
 }
+
+/// The ground, a stiff rope (25 nodes, k = 2·10⁴ N/m) pinned at (0, 3, 0) and hanging
+/// from horizontal, and a 0.6 m crate dropped onto it from 5 m. Returns the rope and the
+/// crate.
+///
+/// # Errors
+/// Constructor errors (none with these values).
+pub fn rope_with_crate(world: &mut World) -> Result<(Chain, Entity)> {
+    ground(world)?;
+    let rope = ChainBuilder::rope(Vec3::new(0.0, 3.0, 0.0), Vec3::new(3.0, 3.0, 0.0), 25)
+        .stiffness(2e4)
+        .spawn(world)?;
+    let crate_ = dynamic_box(world, Vec3::splat(0.3), Vec3::new(1.5, 5.0, 0.0))?;
+    Ok((rope, crate_))
+}
+
+/// The ground, the perf report's `n` × `n` [`cloth`] and a static ball of radius 0.3 m at
+/// (0, 1, 0) for it to fall on. Returns the cloth.
+///
+/// # Errors
+/// Constructor errors (none for `n` ≥ 2).
+pub fn cloth_on_ball(world: &mut World, n: usize) -> Result<Entity> {
+    ground(world)?;
+    let cloth = cloth(world, n)?;
+    world.spawn((
+        crate::RigidBodyBundle::fixed(Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY)?,
+        crate::Collider::ball(0.3)?,
+    ));
+    Ok(cloth)
+}
+
+/// A 0.8 m jelly cube centred at `x`: 3 × 3 × 3 cells of six tetrahedra, co-rotated strain,
+/// E = 200 kPa, ν = 0.3, 1000 kg/m³; on the implicit solver when `implicit`.
+///
+/// # Errors
+/// Constructor errors (none with these values).
+pub fn jelly(world: &mut World, x: Vec3, implicit: bool) -> Result<Entity> {
+    use crate::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+    let mesh = TetMesh::cuboid(Vec3::splat(0.4), [3, 3, 3], CellSplit::Six)?;
+    let material = Material::new(2e5, 0.3, 1000.0)?;
+    let body = SoftBody::build(&mesh, x, material, StrainModel::Corotated)?;
+    let mut e = world.spawn(body);
+    if implicit {
+        e.insert(crate::ImplicitEuler::default());
+    }
+    Ok(e.id())
+}

@@ -14,11 +14,9 @@
 //! file with a note of why the results moved.
 
 use bevy_ecs::prelude::*;
-use hooke::ImplicitEuler;
 use hooke::prelude::*;
 use hooke::scenes;
 use hooke::snapshot::Snapshot;
-use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
 
 const FILE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/goldens/determinism.txt");
 
@@ -43,25 +41,14 @@ fn scenes() -> Vec<Scene> {
         (
             "rope_25_stiff_with_crate",
             |w| {
-                scenes::ground(w).unwrap();
-                ChainBuilder::rope(Vec3::new(0.0, 3.0, 0.0), Vec3::new(3.0, 3.0, 0.0), 25)
-                    .stiffness(2e4)
-                    .spawn(w)
-                    .unwrap();
-                scenes::dynamic_box(w, Vec3::splat(0.3), Vec3::new(1.5, 5.0, 0.0)).unwrap();
+                scenes::rope_with_crate(w).unwrap();
             },
             300,
         ),
         (
             "cloth_12_on_ball",
             |w| {
-                scenes::ground(w).unwrap();
-                scenes::cloth(w, 12).unwrap();
-                w.spawn((
-                    RigidBody::Static,
-                    Collider::ball(0.3).unwrap(),
-                    Position::from(Vec3::new(0.0, 1.0, 0.0)),
-                ));
+                scenes::cloth_on_ball(w, 12).unwrap();
             },
             300,
         ),
@@ -69,15 +56,7 @@ fn scenes() -> Vec<Scene> {
             "jelly_implicit_on_ground",
             |w| {
                 scenes::ground(w).unwrap();
-                let mesh = TetMesh::cuboid(Vec3::splat(0.4), [3, 3, 3], CellSplit::Six).unwrap();
-                let material = Material::new(2e5, 0.3, 1000.0).unwrap();
-                let built = SoftBody::build(
-                    &mesh,
-                    Vec3::new(0.0, 1.0, 0.0),
-                    material,
-                    StrainModel::Corotated,
-                );
-                w.spawn((built.unwrap(), ImplicitEuler::default()));
+                scenes::jelly(w, Vec3::new(0.0, 1.0, 0.0), true).unwrap();
             },
             200,
         ),

@@ -5,7 +5,7 @@
 use bevy_ecs::prelude::*;
 use hooke::prelude::*;
 use hooke::snapshot::{EntityMap, FORMAT_VERSION, Snapshot, SnapshotError};
-use hooke::{AngularMomentum, ImplicitEuler, scenes};
+use hooke::{AngularMomentum, scenes};
 
 /// Every bit of the simulated state of `entities` (poses, velocities, mesh nodes, sleep).
 fn state_bits(world: &World, entities: impl Iterator<Item = Entity>) -> Vec<u32> {
@@ -175,12 +175,7 @@ fn stack_continues_bit_identically() {
 fn rope_continues_bit_identically() {
     round_trip(
         |w| {
-            scenes::ground(w).unwrap();
-            ChainBuilder::rope(Vec3::new(0.0, 3.0, 0.0), Vec3::new(3.0, 3.0, 0.0), 25)
-                .stiffness(2e4)
-                .spawn(w)
-                .unwrap();
-            scenes::dynamic_box(w, Vec3::splat(0.3), Vec3::new(1.5, 5.0, 0.0)).unwrap();
+            scenes::rope_with_crate(w).unwrap();
         },
         nothing,
         via_bytes,
@@ -191,13 +186,7 @@ fn rope_continues_bit_identically() {
 fn cloth_continues_bit_identically() {
     round_trip(
         |w| {
-            scenes::ground(w).unwrap();
-            scenes::cloth(w, 12).unwrap();
-            w.spawn((
-                RigidBody::Static,
-                Collider::ball(0.3).unwrap(),
-                Position::from(Vec3::new(0.0, 1.0, 0.0)),
-            ));
+            scenes::cloth_on_ball(w, 12).unwrap();
         },
         nothing,
         via_bytes,
@@ -209,24 +198,9 @@ fn soft_body_continues_bit_identically() {
     round_trip(
         |w| {
             scenes::ground(w).unwrap();
-            use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
-            let mesh = TetMesh::cuboid(Vec3::splat(0.4), [3, 3, 3], CellSplit::Six).unwrap();
-            let material = Material::new(2e5, 0.3, 1000.0).unwrap();
-            let built = SoftBody::build(
-                &mesh,
-                Vec3::new(0.0, 1.0, 0.0),
-                material,
-                StrainModel::Corotated,
-            );
-            w.spawn(built.unwrap());
+            scenes::jelly(w, Vec3::new(0.0, 1.0, 0.0), false).unwrap();
             // A second one on the implicit solver, whose kept factor is part of the state.
-            let built = SoftBody::build(
-                &mesh,
-                Vec3::new(1.5, 1.0, 0.0),
-                material,
-                StrainModel::Corotated,
-            );
-            w.spawn((built.unwrap(), ImplicitEuler::default()));
+            scenes::jelly(w, Vec3::new(1.5, 1.0, 0.0), true).unwrap();
         },
         nothing,
         via_ron,

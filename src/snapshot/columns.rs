@@ -200,13 +200,9 @@ pub(crate) fn ancient(world: &World) -> Tick {
     Tick::new(world.read_change_tick().get().wrapping_sub(MAX_CHANGE_AGE))
 }
 
-fn map_all<T: Column>(value: &mut T, map: &Map, lenient: bool) -> Result<(), Entity> {
+fn map_all<T: Column>(value: &mut T, map: &Map) -> Result<(), Entity> {
     for e in value.entities_mut() {
-        match map.get(e) {
-            Some(&to) => *e = to,
-            None if lenient => {}
-            None => return Err(*e),
-        }
+        *e = *map.get(e).ok_or(*e)?;
     }
     Ok(())
 }
@@ -263,8 +259,7 @@ macro_rules! columns {
                                 error: e.to_string(),
                             })?;
                         }
-                        let lenient = component == "Quarantined";
-                        map_all(value, map, lenient).map_err(|target| SnapshotError::Dangling {
+                        map_all(value, map).map_err(|target| SnapshotError::Dangling {
                             slot: *slot,
                             component,
                             target,
@@ -274,7 +269,7 @@ macro_rules! columns {
                 Ok(())
             }
 
-            /// The values of one slot, for the checks across components of an entity.
+            /// The node count of every slot that has nodes, for the mesh checks across components.
             pub(crate) fn nodes_of(&self) -> HashMap<u32, usize> {
                 self.nodes.iter().map(|(slot, n)| (*slot, n.len())).collect()
             }

@@ -362,8 +362,8 @@ impl Snapshot {
                 }),
             None => Ok(None),
         };
-        let (contacts, ()) = match (contacts, checked) {
-            (Ok(c), Ok(())) => (c, ()),
+        let contacts = match (contacts, checked) {
+            (Ok(c), Ok(())) => c,
             (Err(e), _) | (_, Err(e)) => {
                 world.entity_allocator_mut().free_many(&fresh);
                 return fail(e);
