@@ -143,7 +143,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if step % 3 != 0 {
             continue;
         }
-        let energy: f32 = [cube, beam]
+        let energy: f64 = [cube, beam]
             .iter()
             .map(|&e| {
                 w.get::<SoftBody>(e)

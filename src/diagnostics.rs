@@ -230,7 +230,7 @@ fn measure_energy(
         }
         if let Some(net) = net {
             counts.mesh_springs += net.len();
-            us += f64::from(net.energy(nodes));
+            us += net.energy(nodes);
         }
     }
     for s in &springs {
@@ -239,7 +239,7 @@ fn measure_energy(
             let (anchor_a, anchor_b) = s.anchors();
             let (pa, _, _) = anchor_state(a, spinning.get(s.a()).ok(), anchor_a);
             let (pb, _, _) = anchor_state(b, spinning.get(s.b()).ok(), anchor_b);
-            us += f64::from(spring_energy(pa, pb, s.rest_length(), s.stiffness()));
+            us += spring_energy(pa, pb, s.rest_length(), s.stiffness());
         }
     }
     // Rotation: T_rot = ½ ω·L; angular momentum about the origin Σ (x × m v) + L.
@@ -254,7 +254,7 @@ fn measure_energy(
     }
     for (w, l, inertia) in &rotating {
         if !inertia.is_infinite() {
-            t_rot += f64::from(rotational_energy(w.0, l.0));
+            t_rot += rotational_energy(w.0, l.0);
             l_total += Vec3::from(l.0).as_dvec3();
         }
     }

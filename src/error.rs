@@ -113,6 +113,10 @@ pub enum Error {
         /// The number of nodes.
         len: usize,
     },
+    /// A component a simulated body needs was removed from it (e.g. [`crate::Mass`] from a
+    /// particle or a dynamic body).
+    #[error("the body's {0} was removed; insert one and remove Quarantined to simulate it again")]
+    ComponentRemoved(&'static str),
     /// An error read back from a snapshot (the message of the error it was).
     #[error("{0}")]
     Restored(String),

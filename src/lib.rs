@@ -146,6 +146,7 @@ pub mod collision;
 pub mod diagnostics;
 pub mod error;
 pub mod integrator;
+mod order;
 pub mod particles;
 pub mod quarantine;
 pub mod rest;

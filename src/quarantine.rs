@@ -63,6 +63,28 @@ pub enum QuarantineReason {
     },
 }
 
+impl core::fmt::Display for QuarantineReason {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let at = |node: &Option<u32>| node.map(|n| format!(" (node {n})")).unwrap_or_default();
+        match self {
+            Self::NonFiniteState => write!(f, "its state became NaN or infinite"),
+            Self::InvalidInput(e) => write!(f, "invalid input: {e}"),
+            Self::OutOfBounds { distance, node } => {
+                write!(f, "it left the world, {distance} m out{}", at(node))
+            }
+            Self::Diverged { speed, node } => {
+                write!(f, "it diverged at {speed} m/s{}", at(node))
+            }
+            Self::GeometryFailed { other } => {
+                write!(f, "the collision geometry failed on its pair with {other}")
+            }
+            Self::SpringFailed { spring, strain } => {
+                write!(f, "spring {spring} failed at strain {strain}")
+            }
+        }
+    }
+}
+
 /// When a finite state counts as diverged (see the module docs). Set a field to
 /// `f32::INFINITY` to turn that check off.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]

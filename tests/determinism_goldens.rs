@@ -6,8 +6,10 @@
 //! a constant, a default setting), a different float environment — another CPU architecture
 //! (aarch64's NEON instead of x86-64 SSE2), `-C target-cpu` flags that enable FMA — and a
 //! different platform math library (sin, cos and exp come from it). The goldens were made on
-//! x86-64 Linux, release profile, default target features; the digest covers entity ids, so
-//! the scenes are built exactly as below.
+//! x86-64 Linux, release profile, default target features. The digest counts entities by
+//! storage order, not by id (a plugin's new resource shifts every id and used to move every
+//! digest), but spawn order is storage order: build the scenes exactly as below. A change to
+//! the snapshot format (a field added to a component) moves them too.
 //!
 //! **Updating them** after a change meant to alter results:
 //! `HOOKE_UPDATE_GOLDENS=1 cargo test --release --test determinism_goldens`, then commit the

@@ -257,3 +257,97 @@ fn bad_contact_settings_are_corrected_and_reported() {
     let y = w.get::<Position>(b).unwrap().get().y;
     assert!((y - 0.5).abs() < 0.01, "{y}");
 }
+
+#[test]
+fn a_body_whose_mass_is_removed_is_quarantined_and_reported_once() {
+    let mut w = world();
+    scenes::ground(&mut w).unwrap();
+    let b = scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::new(0.0, 3.0, 0.0)).unwrap();
+    let p = w
+        .spawn(ParticleBundle::new(Vec3::new(5.0, 3.0, 0.0), Vec3::ZERO, 1.0).unwrap())
+        .id();
+    // Made static, and turned into a tracer: both go without a Mass on purpose.
+    let s = scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::new(3.0, 3.0, 0.0)).unwrap();
+    let t = w
+        .spawn(ParticleBundle::new(Vec3::new(8.0, 3.0, 0.0), Vec3::ZERO, 1.0).unwrap())
+        .id();
+    w.step_physics();
+    w.entity_mut(s).insert(RigidBody::Static);
+    w.entity_mut(t).insert(Tracer);
+    for e in [b, p, s, t] {
+        w.entity_mut(e).remove::<Mass>();
+    }
+    // Before: neither integrated nor checked, so this NaN stayed, unreported.
+    w.get_mut::<LinearVelocity>(b).unwrap().0 = Vec3A::NAN;
+    w.step_physics();
+    let reported: Vec<Entity> = messages::<BodyQuarantined>(&w)
+        .into_iter()
+        .map(|m| m.entity)
+        .collect();
+    w.step_physics();
+    w.step_physics();
+    for e in [b, p] {
+        let q = w.get::<Quarantined>(e).expect("quarantined");
+        assert!(
+            q.reason.to_string().contains("Mass was removed"),
+            "{}",
+            q.reason
+        );
+    }
+    assert_eq!(reported.len(), 2, "{reported:?}");
+    assert!(w.get::<Quarantined>(s).is_none() && w.get::<Quarantined>(t).is_none());
+    assert!(
+        w.resource::<PhysicsDiagnostics>()
+            .kinetic_energy
+            .is_finite()
+    );
+    // Despawning a body removes its Mass too: nothing to report.
+    w.despawn(t);
+    w.step_physics();
+}
+
+/// A density or part offset written through `get_mut` re-weighs the body at the next step (it
+/// was ignored: the body kept its old mass), and a bad one quarantines it.
+#[test]
+fn density_and_offset_written_through_get_mut_are_applied_or_caught() {
+    let mut w = world();
+    w.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
+    let ball = w
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::ball(0.5).unwrap(),
+            ColliderDensity::try_new(500.0).unwrap(),
+        ))
+        .id();
+    let m0 = w.get::<Mass>(ball).unwrap().value();
+    w.get_mut::<ColliderDensity>(ball).unwrap().0 = 1000.0;
+    w.step_physics();
+    let m1 = w.get::<Mass>(ball).unwrap().value();
+    assert!((m1 / m0 - 2.0).abs() < 1e-4, "{m0} -> {m1}");
+
+    let body = w
+        .spawn((RigidBody::Dynamic, Position::from(Vec3::ZERO)))
+        .id();
+    let parts = [-1.0f32, 1.0].map(|dx| {
+        w.spawn((
+            Collider::cuboid(0.5, 0.5, 0.5).unwrap(),
+            ColliderOffset::try_new(Vec3::new(dx, 0.0, 0.0), Quat::IDENTITY).unwrap(),
+            ChildOf(body),
+        ))
+        .id()
+    });
+    w.step_physics();
+    assert!(w.get::<CenterOfMass>(body).unwrap().0.length() < 1e-6);
+    // One part moved 2 m further out: the centre of mass moves 1 m toward it.
+    w.get_mut::<ColliderOffset>(parts[1]).unwrap().translation.x = 3.0;
+    w.step_physics();
+    let com = w.get::<CenterOfMass>(body).unwrap().0;
+    assert!((com - Vec3::X).length() < 1e-5, "{com}");
+
+    w.get_mut::<ColliderDensity>(ball).unwrap().0 = f32::NAN;
+    w.step_physics();
+    let q = w
+        .get::<Quarantined>(ball)
+        .expect("a NaN density quarantines");
+    assert!(q.reason.to_string().contains("density"), "{}", q.reason);
+}

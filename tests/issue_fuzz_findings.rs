@@ -128,3 +128,106 @@ fn springs_restored_before_their_ends_are_not_quarantined() {
     let quarantined = copy.query::<&Quarantined>().iter(&copy).count();
     assert_eq!(quarantined, 0);
 }
+
+/// Energies of large but finite states stay finite: ½ ω·L and ½ k s² of a heavy fast spinner
+/// and a stiff stretched spring overflow f32 (they were summed in f32).
+#[test]
+fn energies_of_large_finite_states_are_finite() {
+    use glam::Vec3;
+    let mut world = World::new();
+    world.add_physics(PhysicsPlugins);
+    world.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
+    let ball = Collider::ball(1.0).unwrap();
+    let props = MassProperties::from_shape(&**ball.shape(), 1e25).unwrap();
+    let spinner = world
+        .spawn((RigidBodyBundle::dynamic(props).unwrap(), ball))
+        .id();
+    world.get_mut::<AngularVelocity>(spinner).unwrap().0.y = 1e8;
+    let a = world
+        .spawn(ParticleBundle::pinned(Vec3::ZERO).unwrap())
+        .id();
+    let b = world
+        .spawn(ParticleBundle::pinned(Vec3::new(1e4, 0.0, 0.0)).unwrap())
+        .id();
+    Spring::from_hooke(a, b, 1.0, 1e33, 0.0)
+        .unwrap()
+        .spawn(&mut world)
+        .unwrap();
+    world.step_physics();
+    assert!(world.get::<Quarantined>(spinner).is_none());
+    let d = world.resource::<PhysicsDiagnostics>();
+    // ½ I ω² with I = 0.4 m r², m = 4/3 π 1e25 kg.
+    let expected_rot = 0.5 * 0.4 * (4.0 / 3.0 * std::f64::consts::PI * 1e25) * 1e16;
+    assert!(
+        (d.rotational_energy / expected_rot - 1.0).abs() < 1e-3,
+        "{} vs {expected_rot}",
+        d.rotational_energy
+    );
+    let expected_spring = 0.5 * 1e33 * (1e4f64 - 1.0).powi(2);
+    assert!(
+        (d.spring_energy / expected_spring - 1.0).abs() < 1e-3,
+        "{} vs {expected_spring}",
+        d.spring_energy
+    );
+    assert!(d.total_energy().is_finite());
+}
+
+/// A kinematic body given an infinite velocity at step 8 moved to infinity in the substep's
+/// integration; the cloth it touched was then pushed out of it in the relax pass, after the
+/// cloth's own check, and held a NaN node for one step, unreported. The nodes now skip a
+/// collider whose state went bad (it is quarantined by its own check).
+#[test]
+fn a_cloth_touching_a_body_gone_bad_is_not_handed_its_nan() {
+    use glam::Vec3;
+    use harness::{Meddle, Tally, Thing, WorldCase};
+    let v = Vec3::new;
+    let case = WorldCase {
+        integrator: 1,
+        substeps: 1,
+        things: vec![
+            Thing::Rope(
+                v(1.6556039, 1.9004717, -3.82871),
+                v(1.9262378, -2.1756353, 0.03983877),
+                3,
+                914.10785,
+                6.540923,
+            ),
+            Thing::Kinematic(
+                v(0.23707527, 2.3590405, 2.4933476),
+                v(4.663382, -1.3013146, -1.5363545),
+            ),
+            Thing::Particle(
+                v(-3.9456575, 4.6993375, 3.7081163),
+                v(6.074169, 5.01801, -6.805982),
+                1e6,
+            ),
+            Thing::Cloth(v(2.8395312, 1.6123738, -1.673399), 2, 0.14282854),
+            Thing::Spinner(
+                v(2.6094797, 3.6236725, -1.4542127),
+                v(198.84665, 123.498886, 26.627428),
+            ),
+            Thing::Cloth(v(-3.2008512, 0.21102, -1.8036999), 6, 0.20240441),
+        ],
+        meddles: vec![
+            (12, Meddle::Despawn(1402820561424497449)),
+            (
+                8,
+                Meddle::SetVelocity(7576034661957303090, v(f32::INFINITY, 1e30, f32::MAX)),
+            ),
+            (25, Meddle::Despawn(17597925222388597335)),
+            (50, Meddle::Despawn(7581547906091735811)),
+        ],
+        steps: 64,
+    };
+    let mut t = Tally::default();
+    harness::run_world(&case, &mut t, true);
+    assert_eq!(
+        (t.panics, t.silent, t.snapshot_mismatches),
+        (0, 0, 0),
+        "{t:?}"
+    );
+    assert!(
+        t.quarantines >= 1,
+        "the kinematic body is quarantined: {t:?}"
+    );
+}

@@ -164,7 +164,7 @@ fn a_free_spinning_wobbling_body_keeps_its_momenta() {
         }
         let e = w.spawn((nodes, body)).id();
         let (p0, l0) = momenta(w.get::<Nodes>(e).unwrap());
-        let mut moved = 0.0f32;
+        let mut moved = 0.0f64;
         for _ in 0..120 {
             w.step_physics();
             moved = moved.max(w.get::<SoftBody>(e).unwrap().stats().elastic_energy);

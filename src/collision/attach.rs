@@ -203,16 +203,20 @@ type WrittenFilter = (
 
 /// A density or offset written through `get_mut` (past the insert hook) is checked as an
 /// insert would be, and its body's mass and compound are rebuilt: before, such a write was
-/// silently ignored (the body kept its old mass) and a NaN one was never reported. Values
-/// just inserted were handled by the hook.
+/// silently ignored (the body kept its old mass) and a NaN one was never reported.
+///
+/// A value inserted since the last step counts too, although its hook already did the
+/// work: a write through `get_mut` right after the spawn, before the first step, carries
+/// the same change tick as the insert and cannot be told apart. The cost is one more
+/// rebuild of such a body, once.
 pub(crate) fn refresh_written_parts(
     mut commands: Commands,
     parts: Query<WrittenPart, WrittenFilter>,
 ) {
     for (e, density, offset) in &parts {
         let written = |r: Option<bool>| r.unwrap_or(false);
-        let d = written(density.as_ref().map(|d| d.is_changed() && !d.is_added()));
-        let o = written(offset.as_ref().map(|o| o.is_changed() && !o.is_added()));
+        let d = written(density.as_ref().map(DetectChanges::is_changed));
+        let o = written(offset.as_ref().map(DetectChanges::is_changed));
         if !(d || o) {
             continue;
         }

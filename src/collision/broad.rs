@@ -334,6 +334,20 @@ pub(crate) struct BroadPhaseRecord {
     pairs: Vec<(Entity, Entity)>,
 }
 
+impl BroadPhaseRecord {
+    /// Renames every entity through `f`; the pairs are put back in order, the sweep's
+    /// entries keep theirs (for a digest that does not depend on entity ids).
+    pub(crate) fn rename(&mut self, f: impl Fn(Entity) -> Entity) {
+        for e in &mut self.moving {
+            e.entity = f(e.entity);
+        }
+        for p in &mut self.pairs {
+            *p = (f(p.0), f(p.1));
+        }
+        self.pairs.sort_unstable();
+    }
+}
+
 impl BroadPhase {
     /// What a snapshot keeps (see [`BroadPhaseRecord`]).
     pub(crate) fn to_record(&self) -> BroadPhaseRecord {

@@ -440,6 +440,21 @@ pub(crate) struct ContactsRecord {
     woken: Vec<(Entity, Entity)>,
 }
 
+impl ContactsRecord {
+    /// Renames every entity through `f` and puts the pairs back in key order (for a digest
+    /// that does not depend on entity ids).
+    pub(crate) fn rename(&mut self, f: impl Fn(Entity) -> Entity) {
+        for p in &mut self.pairs {
+            (p.a, p.b) = (f(p.a), f(p.b));
+        }
+        for w in &mut self.woken {
+            *w = (f(w.0), f(w.1));
+        }
+        self.pairs.sort_by_key(|p| (p.a, p.b));
+        self.woken.sort_unstable();
+    }
+}
+
 /// Whether every point a manifold's data names is one of its points (the solver indexes by
 /// them).
 fn kept_in_range(m: &Manifold) -> bool {

@@ -82,6 +82,7 @@ pub(crate) trait NodeLayer: Component<Mutability = bevy_ecs::component::Mutable>
 }
 
 type Mesh<'a, L> = (
+    Entity,
     &'a mut Nodes,
     &'a mut L,
     Option<&'a ImplicitState>,
@@ -106,17 +107,38 @@ fn side_of(
     })
 }
 
+/// The meshes and colliders of one substep, in entity order.
+#[derive(Default)]
+pub(crate) struct NodeScratch {
+    meshes: Vec<Entity>,
+    near: Vec<Entity>,
+}
+
 /// Projects every soft body's nodes out of the colliders they touch.
+///
+/// Meshes, and the colliders near each, are taken in entity order, not query order: a node
+/// pushed out of one collider is then tested against the next, and a body touched by two
+/// meshes sums their impulses, so the order changes the rounding. A query walks tables in
+/// the order its system first saw them, which a world restored from a snapshot does not
+/// share with the original; entity order it does (restored ids keep the captured order).
 pub(crate) fn collide_nodes<L: NodeLayer>(
     mut commands: Commands,
     time: Res<SubstepTime>,
+    mut scratch: Local<NodeScratch>,
     mut bodies: Query<Mesh<L>, Without<Quarantined>>,
     mut colliders: Query<ColliderPose, (Without<Quarantined>, Without<ColliderOf>)>,
 ) {
     let h = time.h;
+    let NodeScratch { meshes, near } = &mut *scratch;
     // Bodies that get their first soft impulse this substep (inserted at its end).
     let mut fresh: Vec<(Entity, NodeImpulse)> = Vec::new();
-    for (mut nodes, mut body, state, implicit) in &mut bodies {
+    meshes.clear();
+    meshes.extend(bodies.iter().map(|(e, ..)| e));
+    meshes.sort_unstable();
+    for &mesh in meshes.iter() {
+        let Ok((_, mut nodes, mut body, state, implicit)) = bodies.get_mut(mesh) else {
+            continue;
+        };
         let body = body.bypass_change_detection();
         let n = nodes.bypass_change_detection();
         let factor = state
@@ -129,8 +151,21 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
             continue;
         };
         let (lo, hi) = (lo - Vec3::splat(thickness), hi + Vec3::splat(thickness));
-        for (entity, c, x, q, com, aabb, friction, d, pending) in &mut colliders {
-            if aabb.min.cmpgt(hi).any() || aabb.max.cmplt(lo).any() {
+        near.clear();
+        near.extend(colliders.iter().filter_map(|(e, _, _, _, _, aabb, ..)| {
+            (!(aabb.min.cmpgt(hi).any() || aabb.max.cmplt(lo).any())).then_some(e)
+        }));
+        near.sort_unstable();
+        for &entity in near.iter() {
+            let Ok((_, c, x, q, com, aabb, friction, d, pending)) = colliders.get_mut(entity)
+            else {
+                continue;
+            };
+            // A body whose state went bad this substep (a kinematic given an infinite
+            // velocity) is quarantined by its own check; touching it would hand its NaN to
+            // the nodes, whose check has already run.
+            let moving_bad = d.is_some_and(|(v, w, ..)| !(v.0.is_finite() && w.0.is_finite()));
+            if moving_bad || !(x.0.is_finite() && q.0.is_finite()) {
                 continue;
             }
             let pose = crate::collision::shape_pose(x.0, q.0, com);

@@ -108,11 +108,21 @@ impl VelocityField {
     /// A vortex about `axis` (normalised here) through `center`, turning at `rate` rad/s.
     ///
     /// # Errors
-    /// [`crate::Error::NonFinite`] for non-finite input or a zero axis.
+    /// [`crate::Error::NonFinite`] for non-finite input, [`crate::Error::NotPositive`] (the
+    /// axis length) for a zero axis.
     pub fn vortex(center: Vec3, axis: Vec3, rate: f32) -> Result<Self> {
         let center = finite_vec("vortex center", center)?;
         let rate = finite("vortex rate", rate)?;
-        let axis = finite_vec("vortex axis", axis.try_normalize().unwrap_or(Vec3::NAN))?;
+        let axis = finite_vec("vortex axis", axis)?;
+        // Scaled by its largest component first: a huge finite axis (1e30) would overflow
+        // |a|² and be called non-finite.
+        let big = axis.abs().max_element();
+        let axis = (axis / big)
+            .try_normalize()
+            .ok_or(crate::Error::NotPositive {
+                what: "vortex axis length",
+                value: axis.length(),
+            })?;
         Ok(Self::Vortex {
             center,
             omega: axis * rate,

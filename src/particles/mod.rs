@@ -103,10 +103,50 @@ pub struct Force(pub Vec3A);
 /// but a velocity you give it does (a kinematic particle).
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[require(Position, LinearVelocity, Force)]
+#[component(on_remove = quarantine_massless)]
 pub struct Mass {
     /// m, or 0 for pinned bodies so that m·g and m·c·v vanish without a branch.
     mass: f32,
     inverse: f32,
+}
+
+/// Bodies that may go without a [`Mass`] on purpose, by the effects that own them (a rigid
+/// body made static): each entry says whether an entity is one.
+#[derive(Resource, Default)]
+pub(crate) struct MassOptional(pub(crate) Vec<fn(&EntityRef) -> bool>);
+
+/// A body whose [`Mass`] is removed is neither integrated nor checked any more: it would
+/// hang where it is, and a NaN written into it later would go unseen. It is quarantined
+/// instead, and reported. Not a despawn, a tracer (massless by design) or what
+/// [`MassOptional`] exempts.
+fn quarantine_massless(
+    mut world: bevy_ecs::world::DeferredWorld,
+    ctx: bevy_ecs::lifecycle::HookContext,
+) {
+    let entity = ctx.entity;
+    world.commands().queue(move |world: &mut World| {
+        let Ok(e) = world.get_entity(entity) else {
+            return;
+        };
+        let optional = world
+            .get_resource::<MassOptional>()
+            .is_some_and(|m| m.0.iter().any(|exempt| exempt(&e)));
+        if optional
+            || e.contains::<Mass>()
+            || e.contains::<Tracer>()
+            || e.contains::<crate::quarantine::Quarantined>()
+            || !e.contains::<LinearVelocity>()
+        {
+            return;
+        }
+        world
+            .entity_mut(entity)
+            .insert(crate::quarantine::Quarantined {
+                reason: crate::quarantine::QuarantineReason::InvalidInput(Error::ComponentRemoved(
+                    "Mass",
+                )),
+            });
+    });
 }
 
 impl Mass {

@@ -527,11 +527,12 @@ pub fn free_rotation_split(q: Quat, inertia: &Inertia, l: Vec3A, h: f32, strang:
     p * inertia.frame.inverse()
 }
 
-/// Kinetic energy of rotation ½ ω·L (J).
+/// Kinetic energy of rotation ½ ω·L (J), in f64 so that a fast heavy spinner does not
+/// overflow.
 #[must_use]
 #[inline]
-pub fn rotational_energy(omega: Vec3A, l: Vec3A) -> f32 {
-    0.5 * omega.dot(l)
+pub fn rotational_energy(omega: Vec3A, l: Vec3A) -> f64 {
+    0.5 * omega.as_dvec3().dot(l.as_dvec3())
 }
 
 /// ω for integration: derived from L, except for infinite inertia (kinematic bodies), whose

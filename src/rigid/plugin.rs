@@ -29,6 +29,10 @@ pub struct RigidBodyPlugin;
 
 impl WorldPlugin for RigidBodyPlugin {
     fn build(&self, world: &mut World) {
+        world
+            .get_resource_or_init::<crate::particles::MassOptional>()
+            .0
+            .push(|e| e.get::<super::RigidBody>() == Some(&super::RigidBody::Static));
         crate::restore::init::<OrientationUpdate>(world);
         crate::quarantine::validate_writes::<super::AngularDamping>(world);
         crate::quarantine::validate_writes::<super::KinematicTarget>(world);

@@ -269,6 +269,17 @@ macro_rules! columns {
                 Ok(())
             }
 
+            /// Renames every entity a value names through `f` (for the digest).
+            pub(crate) fn rename(&mut self, f: &impl Fn(Entity) -> Entity) {
+                $(
+                    for (_, value) in &mut self.$field {
+                        for e in value.entities_mut() {
+                            *e = f(*e);
+                        }
+                    }
+                )*
+            }
+
             /// The node count of every slot that has nodes, for the mesh checks across components.
             pub(crate) fn nodes_of(&self) -> HashMap<u32, usize> {
                 self.nodes.iter().map(|(slot, n)| (*slot, n.len())).collect()

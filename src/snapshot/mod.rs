@@ -185,6 +185,13 @@ macro_rules! resources {
                 Self { $($field: world.get_resource::<$ty>().cloned(),)* }
             }
 
+            /// Renames the entity a resource names (for the digest).
+            fn rename(&mut self, f: impl Fn(Entity) -> Entity) {
+                if let Some(s) = &mut self.entity_spring_stability {
+                    s.spring = s.spring.map(&f);
+                }
+            }
+
             /// Inserts every resource held, with ticks old enough not to count as changed.
             fn restore(&self, world: &mut World) {
                 let old = columns::ancient(world);
@@ -408,16 +415,44 @@ impl Snapshot {
     }
 
     /// A 64-bit digest of the whole state (FNV-1a over the binary payload): the same inputs
-    /// give the same digest, so a pinned digest shows when a change alters results. It
-    /// covers entity ids too, so compare worlds built the same way.
+    /// give the same digest, so a pinned digest shows when a change alters results. Entities
+    /// are counted by their place in storage order, not by id: a plugin that adds a
+    /// resource (and so shifts every entity id after it) leaves digests as they were. The
+    /// entities a [`crate::QuarantineReason`] names are the exception (kept as ids).
     #[must_use]
     pub fn digest(&self) -> u64 {
-        let payload = postcard::to_stdvec(self).unwrap_or_default();
+        let mut canonical = self.clone();
+        canonical.rename_by_slot();
+        let payload = postcard::to_stdvec(&canonical).unwrap_or_default();
         // FNV-1a: four lines, stable across platforms and versions (a hasher crate's output
         // is not promised to be).
         payload.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
             (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
         })
+    }
+
+    /// Renames every entity to its slot (index = slot, generation 0): the same state spawned
+    /// with other ids (a plugin that adds a resource shifts every id after it) has the
+    /// same digest. An entity that names no slot keeps its id.
+    fn rename_by_slot(&mut self) {
+        let slots: HashMap<Entity, Entity> = self
+            .entities
+            .iter()
+            .enumerate()
+            .filter_map(|(i, &e)| Some((e, Entity::from_raw_u32(i as u32)?)))
+            .collect();
+        let f = |e: Entity| slots.get(&e).copied().unwrap_or(e);
+        self.entities.iter_mut().for_each(|e| *e = f(*e));
+        self.columns.rename(&f);
+        if let Some(c) = &mut self.contacts {
+            c.rename(f);
+        }
+        if let Some(b) = &mut self.broad_phase {
+            b.rename(f);
+        }
+        self.collider_changes.iter_mut().for_each(|e| *e = f(*e));
+        self.collider_changes.sort_unstable();
+        self.resources.rename(f);
     }
 
     /// The compact binary form (see the module docs).

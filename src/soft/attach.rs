@@ -156,6 +156,7 @@ impl NodeAttachments {
 }
 
 type Soft<'a> = (
+    Entity,
     &'a mut Nodes,
     &'a mut NodeAttachments,
     Option<&'a ImplicitState>,
@@ -174,8 +175,13 @@ type Body<'a> = (
 );
 
 /// Solves every attachment once per substep, after both sides have moved.
+///
+/// Meshes are taken in entity order: a body held by two meshes moves with the first one's
+/// link before the second's, and a query's table order is not kept by a restored snapshot
+/// (see [`crate::collision::nodes::collide_nodes`]).
 pub(crate) fn solve_attachments(
     time: Res<SubstepTime>,
+    mut order: Local<Vec<Entity>>,
     mut meshes: Query<Soft, Without<Quarantined>>,
     mut bodies: Query<Body, (Without<Quarantined>, Without<Nodes>)>,
 ) {
@@ -183,7 +189,13 @@ pub(crate) fn solve_attachments(
     if h.is_nan() || h <= 0.0 {
         return;
     }
-    for (mut nodes, mut attachments, state, implicit) in &mut meshes {
+    order.clear();
+    order.extend(meshes.iter().map(|(e, ..)| e));
+    order.sort_unstable();
+    for &mesh in order.iter() {
+        let Ok((_, mut nodes, mut attachments, state, implicit)) = meshes.get_mut(mesh) else {
+            continue;
+        };
         let nodes = nodes.bypass_change_detection();
         let factor = state
             .filter(|_| implicit.is_some())
@@ -195,6 +207,14 @@ pub(crate) fn solve_attachments(
             let Ok(body) = bodies.get_mut(link.body) else {
                 continue;
             };
+            // A body whose state went bad this substep is quarantined by its own check;
+            // the link would hand its NaN to the nodes, whose check has already run.
+            let (x, q, v, _, w, ..) = &body;
+            let moving_bad = v.as_ref().is_some_and(|v| !v.0.is_finite())
+                || w.as_ref().is_some_and(|w| !w.0.is_finite());
+            if moving_bad || !(x.0.is_finite() && q.0.is_finite()) {
+                continue;
+            }
             solve_link(link, nodes, body, factor, h);
         }
     }

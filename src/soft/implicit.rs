@@ -229,7 +229,7 @@ fn record_stats(body: &mut SoftBody, prep: &[(Prepared, Mat3)], elastic: f64) {
         vj += f64::from(vol) * f64::from(j);
         vsum += f64::from(vol);
     }
-    body.stats.elastic_energy = elastic as f32;
+    body.stats.elastic_energy = elastic;
     body.stats.volume_ratio = (vj / vsum) as f32;
     body.stats.inverted = inverted;
 }

@@ -146,7 +146,7 @@ impl Material {
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Default)]
 pub struct SoftBodyStats {
     /// Elastic energy Σ V Ψ(F) (J).
-    pub elastic_energy: f32,
+    pub elastic_energy: f64,
     /// Current volume over rest volume, Σ V J / Σ V.
     pub volume_ratio: f32,
     /// Tetrahedra with det F ≤ 0.
@@ -345,7 +345,7 @@ impl SoftBody {
             scatter_element_forces(f, t, h);
             finite &= h.is_finite();
             let j = f_k.determinant();
-            stats.elastic_energy += vol * s.energy;
+            stats.elastic_energy += f64::from(vol) * f64::from(s.energy);
             stats.inverted += usize::from(j <= 0.0);
             vj += vol * j;
             vsum += vol;

@@ -141,9 +141,6 @@ fn report_elastic_energy(
     diag: Option<ResMut<PhysicsDiagnostics>>,
 ) {
     if let Some(mut diag) = diag {
-        diag.elastic_energy = bodies
-            .iter()
-            .map(|b| f64::from(b.stats().elastic_energy))
-            .sum();
+        diag.elastic_energy = bodies.iter().map(|b| b.stats().elastic_energy).sum();
     }
 }

@@ -158,20 +158,27 @@ pub(crate) fn solve_entity_springs(
     global: Res<Integrator>,
     guard: Res<DivergenceGuard>,
     time: Res<SubstepTime>,
-    springs: Query<(&Spring, Option<&ImplicitEuler>), Live>,
+    springs: Query<(Entity, &Spring, Option<&ImplicitEuler>), Live>,
     bodies: Query<EndBody, Live>,
     spinning: Query<(Spinning, &Inertia), Live>,
     mut forces: Query<&mut Force, Live>,
     mut torques: Query<&mut Torque, Live>,
     mut solve: Local<EntitySolve>,
     mut kept: ResMut<EntitySpringFactor>,
+    (archetypes, spring_id, mut order): (
+        &bevy_ecs::archetype::Archetypes,
+        bevy_ecs::component::ComponentIdFor<Spring>,
+        Local<Vec<Entity>>,
+    ),
 ) {
     let kept = &mut *kept;
     let global = *global;
     let s = &mut *solve;
     s.clear();
     let mut settings = None;
-    for (spring, flag) in &springs {
+    // The nodes are numbered, and the system assembled, in spring order (see `crate::order`).
+    let all = crate::order::stable(&springs, archetypes, spring_id.get(), &mut order, |i| i.0);
+    for (_, spring, flag) in all {
         if !wants_implicit(global, flag.is_some()) {
             continue;
         }

@@ -78,12 +78,13 @@ pub fn spring_force(
     (k * (l - rest) + c * (vb - va).dot(dir)) * dir
 }
 
-/// Potential energy ½ k (l − r)² of a spring (J).
+/// Potential energy ½ k (l − r)² of a spring (J), in f64 so that a large finite stretch
+/// of a stiff spring does not overflow.
 #[must_use]
 #[inline]
-pub fn spring_energy(xa: Vec3A, xb: Vec3A, rest: f32, k: f32) -> f32 {
-    let s = (xb - xa).length() - rest;
-    0.5 * k * s * s
+pub fn spring_energy(xa: Vec3A, xb: Vec3A, rest: f32, k: f32) -> f64 {
+    let s = (xb.as_dvec3() - xa.as_dvec3()).length() - f64::from(rest);
+    0.5 * f64::from(k) * s * s
 }
 
 /// A spring entity between bodies `a` and `b` (entities with a [`Position`]).
@@ -386,7 +387,7 @@ impl SpringNetwork {
 
     /// Potential energy of all springs over `nodes` (J).
     #[must_use]
-    pub fn energy(&self, nodes: &Nodes) -> f32 {
+    pub fn energy(&self, nodes: &Nodes) -> f64 {
         if !self.fits(nodes) {
             return 0.0;
         }

@@ -113,9 +113,16 @@ fn apply_spring_forces(
     mut torques: Query<&mut Torque, Live>,
     masses: Query<&crate::particles::Mass>,
     positions: Query<&Position>,
+    (archetypes, spring_id, mut order): (
+        &bevy_ecs::archetype::Archetypes,
+        bevy_ecs::component::ComponentIdFor<Spring>,
+        Local<Vec<Entity>>,
+    ),
 ) {
     let global = *global;
-    for (spring, s, flagged) in &springs {
+    // Forces on a shared end are summed in spring order (see `crate::order`).
+    let all = crate::order::stable(&springs, archetypes, spring_id.get(), &mut order, |i| i.0);
+    for (spring, s, flagged) in all {
         if super::entity_implicit::wants_implicit(global, flagged) {
             let accepts = |e: Entity| {
                 ends.get(e)

@@ -515,7 +515,16 @@ fn silent_bad(world: &mut World) -> usize {
     for (e, n) in q.iter(world) {
         if !n.is_finite() || n.positions().iter().any(|x| x.abs().max_element() >= BOUND) {
             if verbose {
-                println!("silently bad mesh: {e} max speed {}", n.max_speed());
+                let bad = n
+                    .positions()
+                    .iter()
+                    .position(|x| !x.is_finite() || x.abs().max_element() >= BOUND);
+                println!(
+                    "silently bad mesh: {e} max speed {}, node {bad:?} at {:?} of {}",
+                    n.max_speed(),
+                    bad.map(|i| n.positions()[i]),
+                    n.len()
+                );
             }
             bad += 1;
         }
@@ -557,7 +566,11 @@ pub fn run_world(case: &WorldCase, tally: &mut Tally, check_snapshot: bool) {
             }
             world.step_physics();
             tally.steps += 1;
-            silent += silent_bad(&mut world);
+            let now = silent_bad(&mut world);
+            if now > 0 && std::env::var_os("HOOKE_FUZZ_VERBOSE").is_some() {
+                println!("  at step {step}");
+            }
+            silent += now;
         }
         let quarantined = world.query::<&Quarantined>().iter(&world).count();
         let mut mismatch = false;
@@ -615,8 +628,14 @@ pub fn fuzz_worlds(cases: u32, seed: u64, check_snapshot: bool) -> Tally {
     let mut tally = Tally::default();
     let mut runner = runner(cases, seed);
     let cell = std::cell::RefCell::new(&mut tally);
+    let verbose = std::env::var_os("HOOKE_FUZZ_VERBOSE").is_some();
     let _ = runner.run(&world_case(), |case| {
+        let start = std::time::Instant::now();
         run_world(&case, &mut cell.borrow_mut(), check_snapshot);
+        let took = start.elapsed().as_secs_f64();
+        if verbose && took > 2.0 {
+            println!("slow world ({took:.1} s): {case:?}");
+        }
         Ok(())
     });
     tally
