@@ -61,6 +61,12 @@ pub enum QuarantineReason {
         /// Its strain when it failed (infinite or NaN for a non-finite force).
         strain: f32,
     },
+    /// Its angular speed passed [`DivergenceGuard::max_angular_speed`] while finite (spun up
+    /// by game code or by contacts gone wrong).
+    SpunOut {
+        /// |ω| (rad/s).
+        angular_speed: f32,
+    },
 }
 
 impl core::fmt::Display for QuarantineReason {
@@ -81,6 +87,9 @@ impl core::fmt::Display for QuarantineReason {
             Self::SpringFailed { spring, strain } => {
                 write!(f, "spring {spring} failed at strain {strain}")
             }
+            Self::SpunOut { angular_speed } => {
+                write!(f, "it spun out at {angular_speed} rad/s")
+            }
         }
     }
 }
@@ -99,10 +108,20 @@ pub struct DivergenceGuard {
     /// a body flung to 2e8 m within one step at a speed the step's last pass had undone.
     #[serde(default = "far")]
     pub max_distance: f32,
+    /// Angular speed beyond any body's in a game (rad/s; default 1e5, 16,000 turns a second:
+    /// 265 turns in one 60 Hz step, past anything a step resolves). Game code that spun a
+    /// crate to 2e11 rad/s went unreported and, before the contacts' arc casts were capped,
+    /// held a step for minutes.
+    #[serde(default = "spin_limit")]
+    pub max_angular_speed: f32,
 }
 
 fn far() -> f32 {
     1e6
+}
+
+fn spin_limit() -> f32 {
+    1e5
 }
 
 impl Default for DivergenceGuard {
@@ -111,6 +130,7 @@ impl Default for DivergenceGuard {
             max_speed: 1e4,
             max_spring_strain: 100.0,
             max_distance: far(),
+            max_angular_speed: spin_limit(),
         }
     }
 }

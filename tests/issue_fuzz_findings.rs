@@ -138,11 +138,11 @@ fn energies_of_large_finite_states_are_finite() {
     world.add_physics(PhysicsPlugins);
     world.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
     let ball = Collider::ball(1.0).unwrap();
-    let props = MassProperties::from_shape(&**ball.shape(), 1e25).unwrap();
+    let props = MassProperties::from_shape(&**ball.shape(), 1e30).unwrap();
     let spinner = world
         .spawn((RigidBodyBundle::dynamic(props).unwrap(), ball))
         .id();
-    world.get_mut::<AngularVelocity>(spinner).unwrap().0.y = 1e8;
+    world.get_mut::<AngularVelocity>(spinner).unwrap().0.y = 9e4;
     let a = world
         .spawn(ParticleBundle::pinned(Vec3::ZERO).unwrap())
         .id();
@@ -156,8 +156,8 @@ fn energies_of_large_finite_states_are_finite() {
     world.step_physics();
     assert!(world.get::<Quarantined>(spinner).is_none());
     let d = world.resource::<PhysicsDiagnostics>();
-    // ½ I ω² with I = 0.4 m r², m = 4/3 π 1e25 kg.
-    let expected_rot = 0.5 * 0.4 * (4.0 / 3.0 * std::f64::consts::PI * 1e25) * 1e16;
+    // ½ I ω² with I = 0.4 m r², m = 4/3 π 1e30 kg.
+    let expected_rot = 0.5 * 0.4 * (4.0 / 3.0 * std::f64::consts::PI * 1e30) * 8.1e9;
     assert!(
         (d.rotational_energy / expected_rot - 1.0).abs() < 1e-3,
         "{} vs {expected_rot}",
@@ -229,5 +229,91 @@ fn a_cloth_touching_a_body_gone_bad_is_not_handed_its_nan() {
     assert!(
         t.quarantines >= 1,
         "the kinematic body is quarantined: {t:?}"
+    );
+}
+
+/// A fuzzed world (a stiff explicit jelly, two crates, a ball and a kinematic body; game
+/// code spins a crate to 2e11 rad/s at step 20) held `step_physics` for minutes: the
+/// continuous collision check followed the crate's arc by conservative advancement, whose
+/// steps grow with the turns. Past 16 turns a step it casts along a line, and the crate is
+/// quarantined as spun out. Fails by the watchdog instead of hanging CI.
+#[test]
+fn a_body_spun_absurdly_fast_does_not_hold_the_step() {
+    use glam::Vec3;
+    use harness::{Meddle, Tally, Thing, WorldCase};
+    let v = Vec3::new;
+    let case = WorldCase {
+        integrator: 3,
+        substeps: 2,
+        things: vec![
+            Thing::Crate(
+                v(-2.308208, 3.353462, -3.1796749),
+                v(-2.7441907, -3.7959654, -6.443566),
+                v(0.8450341, 0.5409387, 0.06812489),
+            ),
+            Thing::Ball(
+                v(-2.6559381, 3.0255773, 3.4105127),
+                v(3.6945114, 6.4854684, -7.7592583),
+                1.487864,
+            ),
+            Thing::Jelly(v(1.6671848, 1.5948277, -0.7907054), 3546595300.0, false),
+            Thing::Crate(
+                v(-0.14638935, 1.0459354, 2.6344457),
+                v(-7.3769016, 1.2360449, 2.2048204),
+                v(0.03875513, 0.0894303, 0.43374178),
+            ),
+            Thing::Kinematic(
+                v(-0.82752043, 2.5176105, -1.1994445),
+                v(-1.8355292, -2.6379144, -0.80410504),
+            ),
+        ],
+        meddles: vec![
+            (
+                2,
+                Meddle::Target(11209856509608799323, v(f32::NAN, f32::NEG_INFINITY, -15.6)),
+            ),
+            (
+                36,
+                Meddle::Target(4551478632771304437, v(1e30, 1.1754944e-38, 50.49)),
+            ),
+            (
+                20,
+                Meddle::SetSpin(10662481609487081879, v(1.1754944e-38, 2.1623246e11, 89.45)),
+            ),
+            (27, Meddle::SetRestitution(10041987931408365298, 1e30)),
+        ],
+        steps: 62,
+    };
+    let (done, finished) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut t = Tally::default();
+        harness::run_world(&case, &mut t, true);
+        let _ = done.send(t);
+    });
+    let t = finished
+        .recv_timeout(std::time::Duration::from_secs(300))
+        .expect("the world finishes (it held for minutes)");
+    assert_eq!(
+        (t.panics, t.silent, t.snapshot_mismatches),
+        (0, 0, 0),
+        "{t:?}"
+    );
+}
+
+/// Game code's absurd spin is caught and named, not left spinning unreported.
+#[test]
+fn a_body_spun_past_the_guard_is_quarantined_as_spun_out() {
+    let mut world = World::new();
+    world.add_physics(PhysicsPlugins);
+    scenes::ground(&mut world).unwrap();
+    let spun = scenes::dynamic_box(&mut world, Vec3::splat(0.3), Vec3::new(0.0, 0.3, 0.0)).unwrap();
+    world.step_physics();
+    world.get_mut::<AngularVelocity>(spun).unwrap().0 = Vec3A::new(0.0, 2.16e11, 89.45);
+    world.step_physics();
+    let q = world.get::<Quarantined>(spun).expect("quarantined");
+    assert!(
+        matches!(q.reason, QuarantineReason::SpunOut { angular_speed } if angular_speed > 2e11),
+        "{:?}",
+        q.reason
     );
 }

@@ -224,9 +224,11 @@ fn integrate_orientations(
     global: Res<Integrator>,
     update: Res<OrientationUpdate>,
     time: Res<SubstepTime>,
+    guard: Res<crate::quarantine::DivergenceGuard>,
     mut bodies: Query<OrientationState, Live>,
 ) {
     let h = time.h;
+    let spin_limit = guard.max_angular_speed * guard.max_angular_speed;
     for (e, mut q, l, w, inertia, o) in &mut bodies {
         let method = o.map_or(*global, |o| o.0);
         if matches!(
@@ -239,6 +241,12 @@ fn integrate_orientations(
 
         if !(q.0.is_finite() && l.0.is_finite()) {
             quarantine_non_finite(&mut commands, e);
+        } else if w.0.length_squared() > spin_limit {
+            commands.entity(e).insert(Quarantined {
+                reason: crate::quarantine::QuarantineReason::SpunOut {
+                    angular_speed: w.0.length(),
+                },
+            });
         }
     }
 }

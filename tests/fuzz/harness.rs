@@ -629,7 +629,12 @@ pub fn fuzz_worlds(cases: u32, seed: u64, check_snapshot: bool) -> Tally {
     let mut runner = runner(cases, seed);
     let cell = std::cell::RefCell::new(&mut tally);
     let verbose = std::env::var_os("HOOKE_FUZZ_VERBOSE").is_some();
+    let trace = std::env::var_os("HOOKE_FUZZ_TRACE").is_some();
     let _ = runner.run(&world_case(), |case| {
+        if trace {
+            // The last case written before a hang is the one that hangs.
+            eprintln!("world: {case:?}");
+        }
         let start = std::time::Instant::now();
         run_world(&case, &mut cell.borrow_mut(), check_snapshot);
         let took = start.elapsed().as_secs_f64();
