@@ -117,6 +117,9 @@ pub enum Error {
     /// particle or a dynamic body).
     #[error("the body's {0} was removed; insert one and remove Quarantined to simulate it again")]
     ComponentRemoved(&'static str),
+    /// The world has no physics: add the plugins first (`world.add_physics(PhysicsPlugins)`).
+    #[error("the world has no physics: call add_physics(PhysicsPlugins) first")]
+    NoPhysics,
     /// An error read back from a snapshot (the message of the error it was).
     #[error("{0}")]
     Restored(String),

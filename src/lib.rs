@@ -158,6 +158,7 @@ pub mod sleep;
 pub mod snapshot;
 pub mod soft;
 pub mod springs;
+pub mod testing;
 pub mod time;
 
 /// parry, re-exported so custom shapes ([`Collider::new`]) need no second dependency.
