@@ -34,7 +34,7 @@ pub trait PhysicsTestExt {
     ///
     /// # Errors
     /// [`Error::NoPhysics`] without the plugins; [`Error::NonFinite`] or [`Error::Negative`]
-    /// for a bad time.
+    /// for a bad time; [`Error::OutOfRange`] past 2³² − 1 steps.
     fn steps_for(&self, seconds: f64) -> Result<u64>;
 
     /// Steps [`Self::steps_for`]`(seconds)` times; returns that count.
@@ -69,8 +69,17 @@ impl PhysicsTestExt for World {
     fn steps_for(&self, seconds: f64) -> Result<u64> {
         let time = self.get_resource::<PhysicsTime>().ok_or(Error::NoPhysics)?;
         // Checked as f32 (past f32::MAX it is infinite there too); counted in f64.
-        crate::error::non_negative("run time", seconds as f32)?;
-        Ok((seconds / f64::from(time.dt())).round() as u64)
+        let t = crate::error::non_negative("run time", seconds as f32)?;
+        let steps = (seconds / f64::from(time.dt())).round();
+        // A finite but huge time (1e30 s) would be a loop no test ever leaves.
+        if steps > f64::from(u32::MAX) {
+            return Err(Error::OutOfRange {
+                what: "run time (s)",
+                value: t,
+                range: "at most 2^32 - 1 steps",
+            });
+        }
+        Ok(steps as u64)
     }
 
     fn run_for_seconds(&mut self, seconds: f64) -> Result<u64> {
