@@ -123,9 +123,18 @@ pub enum Error {
     /// An error read back from a snapshot (the message of the error it was).
     #[error("{0}")]
     Restored(String),
+    /// A scenario file is bad (with its line).
+    #[error(transparent)]
+    Scenario(Box<crate::scenario::ScenarioError>),
     /// A snapshot could not be read or restored.
     #[error(transparent)]
     Snapshot(#[from] crate::snapshot::SnapshotError),
+}
+
+impl From<crate::scenario::ScenarioError> for Error {
+    fn from(e: crate::scenario::ScenarioError) -> Self {
+        Error::Scenario(Box::new(e))
+    }
 }
 
 /// Shorthand for hooke results.

@@ -126,6 +126,12 @@
 //! assert!(matches!(Mass::new(f32::NAN), Err(Error::InvalidMass(_))));
 //! ```
 //!
+//! ## Scenarios and tests
+//!
+//! [`scenario`] runs RON files that build a scene, act on it on a timeline and check
+//! expectations (the `hooke` command with the `cli` feature runs them from a shell);
+//! [`testing`] has the helpers a `#[test]` steps a world with.
+//!
 //! ## Order
 //!
 //! [`schedule`] declares it, once: clear forces → apply forces → accumulate torque →
@@ -152,6 +158,7 @@ pub mod quarantine;
 pub mod rest;
 pub mod restore;
 pub mod rigid;
+pub mod scenario;
 pub mod scenes;
 pub mod schedule;
 pub mod sleep;
@@ -258,6 +265,15 @@ impl WorldPlugin for PhysicsCorePlugin {
             world,
             PhysicsSchedule,
             restore::restore_resources.in_set(PhysicsSystems::Restore),
+        );
+        schedule::add_systems(
+            world,
+            PhysicsSchedule,
+            // After every input is written (kinematic targets set velocities too).
+            quarantine::quarantine_runaway_velocities
+                .in_set(PhysicsSystems::Prepare)
+                .after(schedule::PrepareSystems::Inputs)
+                .before(schedule::PrepareSystems::Sleep),
         );
         crate::restore::init::<SubstepTime>(world);
         crate::restore::init::<Messages<BodyQuarantined>>(world);

@@ -280,6 +280,30 @@ pub(crate) fn validate_changed<T: Component + Validate>(
     }
 }
 
+/// A velocity past the guard (game code set a crate to 1e30 m/s) is caught before the step
+/// uses it: the contacts run before the integrators' own check, and a runaway's sweep box
+/// covers the world, so in that one step it flung bodies 30 m away to 1e27 m (found by the
+/// scenario corpus, `scenarios/quarantine_caught.ron`). One compare per moved body.
+pub(crate) fn quarantine_runaway_velocities(
+    mut commands: Commands,
+    guard: Option<Res<DivergenceGuard>>,
+    moved: Query<
+        (
+            Entity,
+            &crate::particles::Position,
+            &crate::particles::LinearVelocity,
+        ),
+        ChangedLive<crate::particles::LinearVelocity>,
+    >,
+) {
+    let guard = guard.map_or_else(DivergenceGuard::default, |g| *g);
+    for (e, x, v) in &moved {
+        if let Some(reason) = guard.check(x.0, v.0, None) {
+            commands.entity(e).try_insert(Quarantined { reason });
+        }
+    }
+}
+
 /// Adds [`validate_changed`] for `T` to the step (effects call it for their cold components).
 pub(crate) fn validate_writes<T: Component + Validate>(world: &mut World) {
     crate::schedule::add_systems(

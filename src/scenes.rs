@@ -571,7 +571,7 @@ pub fn cloth_on_ball(world: &mut World, n: usize) -> Result<Entity> {
     Ok(cloth)
 }
 
-/// A 0.8 m jelly cube centred at `x`: 3 × 3 × 3 cells of six tetrahedra, co-rotated strain,
+/// A 0.4 m jelly cube centred at `x`: 3 × 3 × 3 cells of six tetrahedra, co-rotated strain,
 /// E = 200 kPa, ν = 0.3, 1000 kg/m³; on the implicit solver when `implicit`.
 ///
 /// # Errors

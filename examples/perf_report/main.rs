@@ -14,6 +14,7 @@
 mod bevy_layer;
 mod contacts;
 mod rigid;
+mod scenario;
 mod snapshot;
 mod soft;
 mod springs;
@@ -382,7 +383,7 @@ fn main() {
         "{:<48} {:>14} {:>14} {:>7}  note",
         "name", "ours_ns", "reference_ns", "ratio"
     );
-    // `--only particles|rigid|contacts|springs|snapshot|soft|bevy|dial` runs one group (bevy with `--features bevy`).
+    // `--only particles|rigid|contacts|springs|scenario|snapshot|soft|bevy|dial` runs one group (bevy with `--features bevy`).
     let only = std::env::args()
         .skip_while(|a| a != "--only")
         .nth(1)
@@ -405,6 +406,9 @@ fn main() {
     if run("springs") {
         springs::implicit_springs(&cfg);
         springs::cloth_vs_rapier(&cfg, if quick { 120 } else { 600 });
+    }
+    if run("scenario") {
+        scenario::scenario_lines(&cfg);
     }
     if run("snapshot") {
         snapshot::snapshot_lines(&cfg);
