@@ -63,6 +63,9 @@ pub trait PhysicsTestExt {
     fn velocity_of(&self, e: Entity) -> Option<Vec3>;
     /// A body's angular velocity (rad/s), or None if it has none.
     fn angular_velocity_of(&self, e: Entity) -> Option<Vec3>;
+    /// A body's mass (kg; computed from its colliders for a rigid body, infinite when
+    /// pinned), or None if it has none.
+    fn mass_of(&self, e: Entity) -> Option<f32>;
 }
 
 impl PhysicsTestExt for World {
@@ -122,5 +125,15 @@ impl PhysicsTestExt for World {
 
     fn angular_velocity_of(&self, e: Entity) -> Option<Vec3> {
         self.get::<AngularVelocity>(e).map(AngularVelocity::get)
+    }
+
+    fn mass_of(&self, e: Entity) -> Option<f32> {
+        self.get::<crate::Mass>(e).map(|m| {
+            if m.is_pinned() {
+                f32::INFINITY
+            } else {
+                m.value()
+            }
+        })
     }
 }

@@ -17,6 +17,7 @@ fn a_passing_file_exits_zero_and_prints_each_expectation() {
     let out = hooke(&["run", "scenarios/kick_crate.ron"]);
     let text = String::from_utf8_lossy(&out.stdout);
     assert_eq!(out.status.code(), Some(0), "{text}");
+    // Five expectations and the pinned hash.
     assert_eq!(text.matches("  pass line").count(), 6, "{text}");
     assert!(text.contains("scenarios: 1 passed, 0 failed"), "{text}");
 }

@@ -99,3 +99,22 @@ fn rigid_accessors_read_pose_and_spin() {
     assert!((w.angular_velocity_of(b).unwrap() - Vec3::Y).length() < 1e-5);
     assert_eq!(w.position_of(b), Some(Vec3::Y));
 }
+
+/// Mass without digging the shape out of the collider: a 1 m cube at 1000 kg/m³ is a tonne,
+/// a pinned particle infinite, a world entity without mass None.
+#[test]
+fn mass_of_reads_the_mass_the_colliders_gave() {
+    let mut w = world();
+    let b = w
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::cuboid(0.5, 0.5, 0.5).unwrap(),
+            Position::from(Vec3::Y),
+        ))
+        .id();
+    let pin = w.spawn(ParticleBundle::pinned(Vec3::ZERO).unwrap()).id();
+    let nothing = w.spawn(()).id();
+    assert!((w.mass_of(b).unwrap() - 1000.0).abs() < 0.01);
+    assert_eq!(w.mass_of(pin), Some(f32::INFINITY));
+    assert_eq!(w.mass_of(nothing), None);
+}

@@ -1,14 +1,16 @@
 //! `hooke`: runs scenario files headless and says what held.
 //!
 //! ```text
-//! hooke run [--csv DIR] [--plot DIR] [--quiet] FILE...   run, one line per expectation
+//! hooke run [--csv DIR] [--plot DIR] [--quiet] [--pin] FILE...
+//!                                                        run, one line per expectation
 //! hooke check FILE...                                    read and check the files only
 //! ```
 //!
 //! Exit status: 0 when every expectation of every file held, 1 when one failed, 2 when a
 //! file could not be read or the command line is wrong. `--csv DIR` writes one CSV trace
 //! per traced entity (every named one when the file names none), `--plot DIR` a PNG of
-//! their height and speed against time. Build it with the `cli` feature:
+//! their height and speed against time, `--pin` writes each file's final-state hash into
+//! its `hash:` field (after a deliberate change of results). Build it with the `cli` feature:
 //! `cargo run --release --features cli --bin hooke -- run scenarios/*.ron`.
 
 use std::io::Write;
@@ -31,6 +33,7 @@ struct Args {
     csv: Option<PathBuf>,
     plot: Option<PathBuf>,
     quiet: bool,
+    pin: bool,
 }
 
 fn parse_args() -> Result<Args, String> {
@@ -45,12 +48,14 @@ fn parse_args() -> Result<Args, String> {
         csv: None,
         plot: None,
         quiet: false,
+        pin: false,
     };
     while let Some(a) = it.next() {
         match a.as_str() {
             "--csv" => args.csv = Some(it.next().ok_or("--csv needs a folder")?.into()),
             "--plot" => args.plot = Some(it.next().ok_or("--plot needs a folder")?.into()),
             "--quiet" => args.quiet = true,
+            "--pin" => args.pin = true,
             "-h" | "--help" => return Err(USAGE.into()),
             s if s.starts_with("--") => return Err(format!("unknown option {s}\n{USAGE}")),
             _ => args.files.push(a.into()),
@@ -177,10 +182,33 @@ fn write_outputs(
             t.write_csv(dir.join(format!("{}_{name}.csv", stem(path))))?;
         }
     }
+    if args.pin {
+        pin(path, report)?;
+    }
     if let Some(dir) = &args.plot {
         std::fs::create_dir_all(dir)?;
         plot(report, &dir.join(format!("{}.png", stem(path))))?;
     }
+    Ok(())
+}
+
+/// Writes the report's hash into the file's `hash:` line, or adds one before the closing
+/// parenthesis.
+fn pin(path: &Path, report: &Report) -> Result<(), Box<dyn std::error::Error>> {
+    let text = std::fs::read_to_string(path)?;
+    let line = format!("    hash: \"{}\",", report.hash_hex());
+    let mut lines: Vec<String> = text.lines().map(str::to_owned).collect();
+    if let Some(l) = lines
+        .iter_mut()
+        .find(|l| l.trim_start().starts_with("hash:"))
+    {
+        *l = line;
+    } else if let Some(end) = lines.iter().rposition(|l| l.trim() == ")") {
+        lines.insert(end, line);
+    } else {
+        return Err("no closing parenthesis to put the hash before".into());
+    }
+    std::fs::write(path, lines.join("\n") + "\n")?;
     Ok(())
 }
 

@@ -7,7 +7,7 @@ use glam::{DVec3, Vec3};
 use super::Expectation;
 use super::format::{Check, Quantity};
 use super::report::Outcome;
-use super::run::{Names, members, momentum, resolve};
+use super::run::{Names, group, momentum};
 use crate::{
     AngularVelocity, Contacts, LinearVelocity, Nodes, PhysicsDiagnostics, Position, Quarantined,
     Sleeping,
@@ -21,30 +21,51 @@ pub(super) struct Kin {
     pub w: DVec3,
 }
 
-/// An entity's motion: its own, or for a mesh the mean of its nodes.
-pub(super) fn kinematics(world: &World, e: Entity) -> Option<Kin> {
-    if let Some(nodes) = world.get::<Nodes>(e) {
-        let n = nodes.len();
-        if n == 0 {
-            return None;
-        }
-        let mean = |s: &[glam::Vec3A]| {
-            s.iter().map(|p| Vec3::from(*p).as_dvec3()).sum::<DVec3>() / n as f64
-        };
-        return Some(Kin {
-            x: mean(nodes.positions()),
-            v: mean(nodes.velocities()),
-            w: DVec3::ZERO,
-        });
+type KinData = (
+    Option<&'static Nodes>,
+    Option<&'static Position>,
+    Option<&'static LinearVelocity>,
+    Option<&'static AngularVelocity>,
+);
+
+/// Reads entities' motion through one cached query: the checks read every member of a
+/// group at every step, and a query's lookup is a few times cheaper than `World::get` per
+/// component.
+pub(super) struct Probe(QueryState<KinData>);
+
+impl Probe {
+    pub(super) fn new(world: &mut World) -> Self {
+        Self(world.query::<KinData>())
     }
-    let x = world.get::<Position>(e)?.get().as_dvec3();
-    let v = world
-        .get::<LinearVelocity>(e)
-        .map_or(DVec3::ZERO, |v| v.get().as_dvec3());
-    let w = world
-        .get::<AngularVelocity>(e)
-        .map_or(DVec3::ZERO, |w| w.get().as_dvec3());
-    Some(Kin { x, v, w })
+
+    /// Sees archetypes created since (spawns, inserted components).
+    pub(super) fn refresh(&mut self, world: &World) {
+        self.0.update_archetypes(world);
+    }
+
+    /// An entity's motion: its own, or for a mesh the mean of its nodes.
+    pub(super) fn get(&self, world: &World, e: Entity) -> Option<Kin> {
+        let (nodes, x, v, w) = self.0.get_manual(world, e).ok()?;
+        if let Some(nodes) = nodes {
+            let n = nodes.len();
+            if n == 0 {
+                return None;
+            }
+            let mean = |s: &[glam::Vec3A]| {
+                s.iter().map(|p| Vec3::from(*p).as_dvec3()).sum::<DVec3>() / n as f64
+            };
+            return Some(Kin {
+                x: mean(nodes.positions()),
+                v: mean(nodes.velocities()),
+                w: DVec3::ZERO,
+            });
+        }
+        Some(Kin {
+            x: x?.get().as_dvec3(),
+            v: v.map_or(DVec3::ZERO, |v| v.get().as_dvec3()),
+            w: w.map_or(DVec3::ZERO, |w| w.get().as_dvec3()),
+        })
+    }
 }
 
 fn quantity(k: &Kin, q: Quantity) -> f64 {
@@ -93,6 +114,10 @@ struct Sample {
 #[derive(Debug, Clone)]
 enum Reading {
     Value(&'static str, f64, &'static str),
+    Axes([Option<f64>; 3]),
+    Energy(f64, f64),
+    Momentum(f64, f64),
+    Closed(Quantity, f64, f64),
     Missing(String),
     Text(String),
 }
@@ -101,6 +126,22 @@ impl Reading {
     fn show(&self) -> String {
         match self {
             Reading::Value(what, v, unit) => format!("{what} = {v:.6} {unit}"),
+            Reading::Axes(a) => {
+                let parts: Vec<String> = ["x", "y", "z"]
+                    .iter()
+                    .zip(a)
+                    .filter_map(|(n, v)| v.map(|v| format!("{n} = {v:.6}")))
+                    .collect();
+                format!("{} m", parts.join(", "))
+            }
+            Reading::Energy(dev, e0) => format!("E - E0 = {dev:+.6} J (E0 = {e0:.6} J)"),
+            Reading::Momentum(dev, p0) => format!("|P - P0| = {dev:.6} kg m/s (|P0| = {p0:.6})"),
+            Reading::Closed(q, v, want) => format!(
+                "{} = {v:.6} {u}, closed form {want:.6} {u} (off by {:+.2e})",
+                name(*q),
+                v - want,
+                u = unit(*q)
+            ),
             Reading::Missing(who) => format!("{who} is gone"),
             Reading::Text(t) => t.clone(),
         }
@@ -138,16 +179,33 @@ fn bounded(v: f64, min: Option<f64>, max: Option<f64>) -> (bool, f64) {
     (margin >= 0.0, -margin)
 }
 
+/// A value against optional bounds (given in f32, as the file's fields are).
+fn sample(
+    v: f64,
+    min: Option<f32>,
+    max: Option<f32>,
+    what: &'static str,
+    unit: &'static str,
+) -> Sample {
+    let (ok, closeness) = bounded(v, min.map(f64::from), max.map(f64::from));
+    Sample {
+        ok,
+        closeness,
+        text: Reading::Value(what, v, unit),
+    }
+}
+
 /// Reads each member; keeps the one closest to failing. An empty group is a failure.
 fn each(
     world: &World,
+    probe: &Probe,
     group: &[Entity],
     who: &str,
     mut read: impl FnMut(&Kin) -> Sample,
 ) -> Sample {
     let mut worst: Option<Sample> = None;
     for &e in group {
-        let s = match kinematics(world, e) {
+        let s = match probe.get(world, e) {
             Some(k) => read(&k),
             None => Sample {
                 ok: false,
@@ -173,26 +231,35 @@ fn touching(world: &World, names: &Names, a: &str, b: &str) -> bool {
     let Some(contacts) = world.get_resource::<Contacts>() else {
         return false;
     };
-    let (ga, gb) = (
-        members(names, &resolve(names, a)),
-        members(names, &resolve(names, b)),
-    );
+    let (ga, gb) = (group(names, a), group(names, b));
     ga.iter()
         .any(|&x| gb.iter().any(|&y| x != y && contacts.are_touching(x, y)))
 }
 
-/// Checks `x` at time `t` (s); `g` is |gravity| for closed forms, `quarantined` the bodies
-/// quarantined in the step just taken.
-pub(super) fn evaluate(
-    world: &World,
-    names: &Names,
-    x: &Expectation,
-    track: &mut Track,
-    t: f64,
-    g: f64,
-    quarantined: &[(Entity, String)],
-) {
-    let group = |who: &str| members(names, &resolve(names, who));
+/// The world at one step, as the checks read it.
+pub(super) struct Moment<'a> {
+    pub world: &'a World,
+    pub probe: &'a Probe,
+    pub names: &'a Names,
+    /// Time since the start (s).
+    pub t: f64,
+    /// |gravity| at the start (m/s²), for closed forms.
+    pub g: f64,
+    /// The bodies quarantined in the step just taken, and why.
+    pub quarantined: &'a [(Entity, String)],
+}
+
+/// Checks `x` at moment `m`.
+pub(super) fn evaluate(m: &Moment, x: &Expectation, track: &mut Track) {
+    let Moment {
+        world,
+        probe,
+        names,
+        t,
+        g,
+        quarantined,
+    } = *m;
+    let group = |who: &str| group(names, who);
     match &x.check {
         Check::Position {
             entity,
@@ -200,20 +267,23 @@ pub(super) fn evaluate(
             y: ry,
             z: rz,
         } => {
-            let s = each(world, group(entity), entity, |k| {
-                let (mut ok, mut closeness, mut parts) = (true, f64::NEG_INFINITY, Vec::new());
-                for (r, v, what) in [(rx, k.x.x, "x"), (ry, k.x.y, "y"), (rz, k.x.z, "z")] {
+            let s = each(world, probe, group(entity), entity, |k| {
+                let (mut ok, mut closeness, mut axes) = (true, f64::NEG_INFINITY, [None; 3]);
+                for (i, (r, v)) in [(rx, k.x.x), (ry, k.x.y), (rz, k.x.z)]
+                    .into_iter()
+                    .enumerate()
+                {
                     if let Some((lo, hi)) = r {
                         let (held, c) = bounded(v, Some(f64::from(*lo)), Some(f64::from(*hi)));
                         ok &= held;
                         closeness = closeness.max(c);
-                        parts.push(format!("{what} = {v:.6}"));
+                        axes[i] = Some(v);
                     }
                 }
                 Sample {
                     ok,
                     closeness,
-                    text: Reading::Text(format!("{} m", parts.join(", "))),
+                    text: Reading::Axes(axes),
                 }
             });
             track.record(t, s);
@@ -224,38 +294,20 @@ pub(super) fn evaluate(
             within,
         } => {
             let p = point.as_dvec3();
-            let s = each(world, group(entity), entity, |k| {
-                let d = k.x.distance(p);
-                let (ok, c) = bounded(d, None, Some(f64::from(*within)));
-                Sample {
-                    ok,
-                    closeness: c,
-                    text: Reading::Value("distance", d, "m"),
-                }
+            let s = each(world, probe, group(entity), entity, |k| {
+                sample(k.x.distance(p), None, Some(*within), "distance", "m")
             });
             track.record(t, s);
         }
         Check::Speed { entity, min, max } => {
-            let s = each(world, group(entity), entity, |k| {
-                let v = k.v.length();
-                let (ok, c) = bounded(v, min.map(f64::from), max.map(f64::from));
-                Sample {
-                    ok,
-                    closeness: c,
-                    text: Reading::Value("speed", v, "m/s"),
-                }
+            let s = each(world, probe, group(entity), entity, |k| {
+                sample(k.v.length(), *min, *max, "speed", "m/s")
             });
             track.record(t, s);
         }
         Check::AngularSpeed { entity, min, max } => {
-            let s = each(world, group(entity), entity, |k| {
-                let w = k.w.length();
-                let (ok, c) = bounded(w, min.map(f64::from), max.map(f64::from));
-                Sample {
-                    ok,
-                    closeness: c,
-                    text: Reading::Value("angular speed", w, "rad/s"),
-                }
+            let s = each(world, probe, group(entity), entity, |k| {
+                sample(k.w.length(), *min, *max, "angular speed", "rad/s")
             });
             track.record(t, s);
         }
@@ -265,7 +317,7 @@ pub(super) fn evaluate(
             ..
         } => {
             for &e in group(entity) {
-                if let Some(k) = kinematics(world, e) {
+                if let Some(k) = probe.get(world, e) {
                     let v = quantity(&k, *q);
                     if track.peak.is_none_or(|(p, _)| v > p) {
                         track.peak = Some((v, t));
@@ -288,7 +340,7 @@ pub(super) fn evaluate(
                 Sample {
                     ok,
                     closeness: c,
-                    text: Reading::Text(format!("E - E0 = {dev:+.6} J (E0 = {e0:.6} J)")),
+                    text: Reading::Energy(dev, e0),
                 },
             );
         }
@@ -311,10 +363,7 @@ pub(super) fn evaluate(
                 Sample {
                     ok,
                     closeness: c,
-                    text: Reading::Text(format!(
-                        "|P - P0| = {dev:.6} kg m/s (|P0| = {:.6})",
-                        p0.length()
-                    )),
+                    text: Reading::Momentum(dev, p0.length()),
                 },
             );
         }
@@ -392,18 +441,14 @@ pub(super) fn evaluate(
         } => {
             let Some(expr) = &x.expr else { return };
             let want = expr.eval(t, g);
-            let s = each(world, group(entity), entity, |k| {
+            let s = each(world, probe, group(entity), entity, |k| {
                 let v = quantity(k, *q);
                 let err = v - want;
                 let (ok, c) = bounded(err.abs(), None, Some(*tolerance));
                 Sample {
                     ok,
                     closeness: c,
-                    text: Reading::Text(format!(
-                        "{} = {v:.6} {u}, closed form {want:.6} {u} (off by {err:+.2e})",
-                        name(*q),
-                        u = unit(*q)
-                    )),
+                    text: Reading::Closed(*q, v, want),
                 }
             });
             track.record(t, s);

@@ -8,7 +8,7 @@ use bevy_ecs::message::{MessageCursor, Messages};
 use bevy_ecs::prelude::*;
 use glam::{DVec3, Vec3};
 
-use super::check::{Kin, Track, evaluate, finish, kinematics};
+use super::check::{Kin, Moment, Probe, Track, evaluate, finish};
 use super::format::{Action, PluginName};
 use super::report::{Outcome, Report, Trace};
 use super::{Scenario, ScenarioError, ScenarioErrorKind, Selector, spawn};
@@ -52,6 +52,31 @@ fn parse_selector(text: &str) -> Selector {
         name: name.to_owned(),
         index: index.map(|i| i as usize),
         text: text.to_owned(),
+    }
+}
+
+/// The entities `name` or `name[i]` (negative from the end) names now, without allocating:
+/// the checks call this for every expectation at every step.
+pub(super) fn group<'a>(names: &'a Names, text: &str) -> &'a [Entity] {
+    let (name, index) = match text.find('[') {
+        Some(open) if text.ends_with(']') => (
+            &text[..open],
+            text[open + 1..text.len() - 1].trim().parse::<i64>().ok(),
+        ),
+        _ => (text, None),
+    };
+    let Some(all) = names.get(name) else {
+        return &[];
+    };
+    match index {
+        None => all,
+        Some(i) => {
+            let k = if i < 0 { all.len() as i64 + i } else { i };
+            usize::try_from(k)
+                .ok()
+                .and_then(|k| all.get(k))
+                .map_or(&[], std::slice::from_ref)
+        }
     }
 }
 
@@ -119,7 +144,7 @@ pub(super) fn build(s: &Scenario) -> Result<(World, Names), ScenarioError> {
 }
 
 fn single(names: &Names, text: &str) -> Option<Entity> {
-    match members(names, &resolve(names, text)) {
+    match group(names, text) {
         [e] => Some(*e),
         _ => None,
     }
@@ -144,6 +169,7 @@ pub(super) fn run(s: &Scenario, options: &mut RunOptions) -> Result<Report, Scen
     let g = f64::from(s.settings.gravity.length());
     let mut tracks: Vec<Track> = s.expectations.iter().map(|_| Track::default()).collect();
     let mut undo = Undo::default();
+    let mut probe = Probe::new(&mut world);
     let traced: Vec<Selector> = if s.trace.is_empty() && options.trace_all {
         let mut all: Vec<_> = s
             .entities
@@ -152,7 +178,7 @@ pub(super) fn run(s: &Scenario, options: &mut RunOptions) -> Result<Report, Scen
             .filter(|n| {
                 names
                     .get(*n)
-                    .is_some_and(|v| v.iter().any(|e| kinematics(&world, *e).is_some()))
+                    .is_some_and(|v| v.iter().any(|e| probe.get(&world, *e).is_some()))
             })
             .map(|n| parse_selector(n))
             .collect();
@@ -187,14 +213,23 @@ pub(super) fn run(s: &Scenario, options: &mut RunOptions) -> Result<Report, Scen
                 .map_err(|e| s.error(a.line, ScenarioErrorKind::Build(e)))?;
             next_action += 1;
         }
+        probe.refresh(&world);
         let t = step as f64 * dt;
+        let moment = Moment {
+            world: &world,
+            probe: &probe,
+            names: &names,
+            t,
+            g,
+            quarantined: &quarantined_now,
+        };
         for (x, track) in s.expectations.iter().zip(&mut tracks) {
             if (x.window.first..=x.window.last).contains(&step) {
-                evaluate(&world, &names, x, track, t, g, &quarantined_now);
+                evaluate(&moment, x, track);
             }
         }
         for (sel, trace) in traced.iter().zip(&mut traces) {
-            if let Some(k) = mean_kinematics(&world, members(&names, sel)) {
+            if let Some(k) = mean_kinematics(&world, &probe, members(&names, sel)) {
                 trace
                     .rows
                     .push([t, k.x.x, k.x.y, k.x.z, k.v.x, k.v.y, k.v.z, k.v.length()]);
@@ -238,11 +273,11 @@ pub(super) fn run(s: &Scenario, options: &mut RunOptions) -> Result<Report, Scen
 }
 
 /// The mean position and velocity of a group (one entity: its own).
-pub(super) fn mean_kinematics(world: &World, group: &[Entity]) -> Option<Kin> {
+pub(super) fn mean_kinematics(world: &World, probe: &Probe, group: &[Entity]) -> Option<Kin> {
     let mut sum = Kin::default();
     let mut n = 0.0;
     for e in group {
-        if let Some(k) = kinematics(world, *e) {
+        if let Some(k) = probe.get(world, *e) {
             sum.x += k.x;
             sum.v += k.v;
             sum.w += k.w;
@@ -262,7 +297,7 @@ fn act(
     action: &Action,
     undo: &mut Undo,
 ) -> Result<(), Error> {
-    let group = |names: &Names, text: &str| members(names, &resolve(names, text)).to_vec();
+    let group = |names: &Names, text: &str| group(names, text).to_vec();
     match action {
         Action::Impulse { entity, impulse } => {
             let j = finite_vec("impulse", *impulse)?;
