@@ -269,11 +269,7 @@ impl WorldPlugin for PhysicsCorePlugin {
         schedule::add_systems(
             world,
             PhysicsSchedule,
-            // After every input is written (kinematic targets set velocities too).
-            quarantine::quarantine_runaway_velocities
-                .in_set(PhysicsSystems::Prepare)
-                .after(schedule::PrepareSystems::Inputs)
-                .before(schedule::PrepareSystems::Sleep),
+            quarantine::quarantine_runaway_velocities.in_set(schedule::PrepareSystems::Guard),
         );
         crate::restore::init::<SubstepTime>(world);
         crate::restore::init::<Messages<BodyQuarantined>>(world);

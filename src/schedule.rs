@@ -155,6 +155,9 @@ pub enum RelaxSystems {
 pub enum PrepareSystems {
     /// Inputs and bookkeeping.
     Inputs,
+    /// Velocities game code wrote past the [`crate::DivergenceGuard`] are quarantined before
+    /// the contacts use them.
+    Guard,
     /// Islands fall asleep or wake.
     Sleep,
     /// Bounding boxes, broad phase, narrow phase, contact constraints.
@@ -217,6 +220,7 @@ pub(crate) fn init_schedules(world: &mut World) {
     physics.configure_sets(
         (
             PrepareSystems::Inputs,
+            PrepareSystems::Guard,
             PrepareSystems::Sleep,
             PrepareSystems::Collision,
         )

@@ -120,6 +120,8 @@ enum Reading {
     Closed(Quantity, f64, f64),
     Missing(String),
     Text(String),
+    Fixed(&'static str),
+    Asleep(usize, usize),
 }
 
 impl Reading {
@@ -144,6 +146,8 @@ impl Reading {
             ),
             Reading::Missing(who) => format!("{who} is gone"),
             Reading::Text(t) => t.clone(),
+            Reading::Fixed(t) => (*t).to_owned(),
+            Reading::Asleep(n, of) => format!("{n} of {of} asleep"),
         }
     }
 }
@@ -379,25 +383,22 @@ pub(super) fn evaluate(m: &Moment, x: &Expectation, track: &mut Track) {
                 Sample {
                     ok: !hit,
                     closeness: 0.0,
-                    text: Reading::Text(if hit {
-                        "touching".into()
-                    } else {
-                        "apart".into()
-                    }),
+                    text: Reading::Fixed(if hit { "touching" } else { "apart" }),
                 },
             );
         }
         Check::NoQuarantine => {
+            // Only a failure is formatted; a quiet step allocates nothing.
             let text = match quarantined.first() {
-                Some((e, why)) => format!("{e} quarantined: {why}"),
-                None => "none quarantined".into(),
+                Some((e, why)) => Reading::Text(format!("{e} quarantined: {why}")),
+                None => Reading::Fixed("none quarantined"),
             };
             track.record(
                 t,
                 Sample {
                     ok: quarantined.is_empty(),
                     closeness: 0.0,
-                    text: Reading::Text(text),
+                    text,
                 },
             );
         }
@@ -423,13 +424,12 @@ pub(super) fn evaluate(m: &Moment, x: &Expectation, track: &mut Track) {
                 } else {
                     asleep == 0
                 };
-            let text = format!("{asleep} of {} asleep", members.len());
             track.record(
                 t,
                 Sample {
                     ok,
                     closeness: 0.0,
-                    text: Reading::Text(text),
+                    text: Reading::Asleep(asleep, members.len()),
                 },
             );
         }

@@ -483,21 +483,14 @@ fn selector_at(
     (first, last): (u64, u64),
     despawning: bool,
 ) -> Result<Selector, ScenarioError> {
-    let (name, index) = match text.find('[') {
-        Some(open) if text.ends_with(']') => {
-            let i: i64 = text[open + 1..text.len() - 1].trim().parse().map_err(|_| {
-                r.error(
-                    line,
-                    1,
-                    ScenarioErrorKind::BadValue(format!(
-                        "\"{text}\": the index must be a whole number"
-                    )),
-                )
-            })?;
-            (&text[..open], Some(i))
-        }
-        _ => (text, None),
-    };
+    let (name, index) = super::split_selector(text);
+    let index = index.map_err(|()| {
+        r.error(
+            line,
+            1,
+            ScenarioErrorKind::BadValue(format!("\"{text}\": the index must be a whole number")),
+        )
+    })?;
     let Some(life) = lives.get(name) else {
         return Err(r.error(line, 1, ScenarioErrorKind::UnknownEntity(name.to_owned())));
     };

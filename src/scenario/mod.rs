@@ -108,6 +108,22 @@ struct Selector {
     text: String,
 }
 
+/// Splits `name[i]` into the name and the index as written (negative counts from the end);
+/// a plain name has no index, and an index that is not a whole number is `Err(())`.
+fn split_selector(text: &str) -> (&str, Result<Option<i64>, ()>) {
+    match text.find('[') {
+        Some(open) if text.ends_with(']') => (
+            &text[..open],
+            text[open + 1..text.len() - 1]
+                .trim()
+                .parse::<i64>()
+                .map(Some)
+                .map_err(|_| ()),
+        ),
+        _ => (text, Ok(None)),
+    }
+}
+
 /// A bad scenario file: where, and what.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[error("{file}:{line}:{column}: {kind}")]

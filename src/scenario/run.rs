@@ -40,31 +40,11 @@ pub(super) fn members<'a>(names: &'a Names, sel: &Selector) -> &'a [Entity] {
     }
 }
 
-fn parse_selector(text: &str) -> Selector {
-    let (name, index) = match text.find('[') {
-        Some(open) if text.ends_with(']') => (
-            &text[..open],
-            text[open + 1..text.len() - 1].trim().parse::<i64>().ok(),
-        ),
-        _ => (text, None),
-    };
-    Selector {
-        name: name.to_owned(),
-        index: index.map(|i| i as usize),
-        text: text.to_owned(),
-    }
-}
-
 /// The entities `name` or `name[i]` (negative from the end) names now, without allocating:
 /// the checks call this for every expectation at every step.
 pub(super) fn group<'a>(names: &'a Names, text: &str) -> &'a [Entity] {
-    let (name, index) = match text.find('[') {
-        Some(open) if text.ends_with(']') => (
-            &text[..open],
-            text[open + 1..text.len() - 1].trim().parse::<i64>().ok(),
-        ),
-        _ => (text, None),
-    };
+    let (name, index) = super::split_selector(text);
+    let index = index.ok().flatten();
     let Some(all) = names.get(name) else {
         return &[];
     };
@@ -78,21 +58,6 @@ pub(super) fn group<'a>(names: &'a Names, text: &str) -> &'a [Entity] {
                 .map_or(&[], std::slice::from_ref)
         }
     }
-}
-
-/// A selector as written, negative indices resolved against the live group.
-pub(super) fn resolve(names: &Names, text: &str) -> Selector {
-    let mut s = parse_selector(text);
-    if let Some(i) = text.find('[').and_then(|o| {
-        text[o + 1..text.len().saturating_sub(1)]
-            .trim()
-            .parse::<i64>()
-            .ok()
-    }) {
-        let n = names.get(&s.name).map_or(0, Vec::len) as i64;
-        s.index = Some(if i < 0 { (n + i).max(0) } else { i } as usize);
-    }
-    s
 }
 
 fn add_plugin(world: &mut World, p: PluginName) {
@@ -180,7 +145,11 @@ pub(super) fn run(s: &Scenario, options: &mut RunOptions) -> Result<Report, Scen
                     .get(*n)
                     .is_some_and(|v| v.iter().any(|e| probe.get(&world, *e).is_some()))
             })
-            .map(|n| parse_selector(n))
+            .map(|n| Selector {
+                name: n.clone(),
+                index: None,
+                text: n.clone(),
+            })
             .collect();
         all.sort_by(|a, b| a.name.cmp(&b.name));
         all
@@ -273,7 +242,7 @@ pub(super) fn run(s: &Scenario, options: &mut RunOptions) -> Result<Report, Scen
 }
 
 /// The mean position and velocity of a group (one entity: its own).
-pub(super) fn mean_kinematics(world: &World, probe: &Probe, group: &[Entity]) -> Option<Kin> {
+fn mean_kinematics(world: &World, probe: &Probe, group: &[Entity]) -> Option<Kin> {
     let mut sum = Kin::default();
     let mut n = 0.0;
     for e in group {
@@ -391,9 +360,8 @@ fn act(
             for e in group(names, entity) {
                 world.despawn(e);
             }
-            let sel = resolve(names, entity);
-            if sel.index.is_none() {
-                names.remove(&sel.name);
+            if let (name, Ok(None)) = super::split_selector(entity) {
+                names.remove(name);
             }
         }
         Action::Pin { entity } => {
