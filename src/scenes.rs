@@ -441,6 +441,43 @@ pub fn box_column(world: &mut World, n: usize) -> Result<Vec<Entity>> {
     spawn_boxes(world, &column_spec(n))
 }
 
+/// The squeeze: the ground and three unit boxes stacked, bottom first (the densities are
+/// [`squeeze_densities`]'s).
+#[must_use]
+pub fn squeeze_spec() -> Vec<BoxSpec> {
+    column_spec(3)
+}
+
+/// Densities (kg/m³) for [`squeeze_spec`], ground first (unused): a light 1 t unit box
+/// between two boxes `ratio` times heavier.
+#[must_use]
+pub fn squeeze_densities(ratio: f32) -> [f32; 4] {
+    [0.0, 1000.0 * ratio, 1000.0, 1000.0 * ratio]
+}
+
+/// [`squeeze_spec`], spawned: returns the bottom, light and top boxes. A hard case for an
+/// iterative contact solver: the light box must pass the top box's whole weight to the
+/// bottom one.
+///
+/// # Errors
+/// [`crate::Error::NotPositive`] or [`crate::Error::NonFinite`] for a bad `ratio`.
+pub fn squeeze(world: &mut World, ratio: f32) -> Result<[Entity; 3]> {
+    crate::error::positive("mass ratio", ratio)?;
+    let rho = squeeze_densities(ratio);
+    let mut out = [Entity::PLACEHOLDER; 3];
+    for (i, b) in squeeze_spec().iter().enumerate() {
+        if b.fixed {
+            spawn_box(world, b)?;
+            continue;
+        }
+        let collider = crate::Collider::cuboid(b.half.x, b.half.y, b.half.z)?;
+        let props = crate::MassProperties::from_shape(&**collider.shape(), rho[i])?;
+        let body = crate::RigidBodyBundle::dynamic(props)?.at(b.position)?;
+        out[i - 1] = world.spawn((body, collider)).id();
+    }
+    Ok(out)
+}
+
 /// A soft beam along x from 0 to `length` (m), square `side` (m), meshed `cells` (6 tets a
 /// cell), with its nodes at x = 0 pinned: the cantilever of the FEM tests and the accuracy
 /// chart.

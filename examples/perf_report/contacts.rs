@@ -20,24 +20,7 @@ fn ours(specs: &[BoxSpec]) -> (World, Vec<Entity>) {
 }
 
 fn theirs(specs: &[BoxSpec]) -> (rp::PhysicsWorld, Vec<rp::RigidBodyHandle>) {
-    let mut world = rp::PhysicsWorld::new();
-    world.integration_parameters.dt = 1.0 / 60.0;
-    let mut handles = Vec::new();
-    for b in specs {
-        let collider = rp::ColliderBuilder::cuboid(b.half.x, b.half.y, b.half.z).density(1000.0);
-        let body = if b.fixed {
-            rp::RigidBodyBuilder::fixed()
-        } else {
-            rp::RigidBodyBuilder::dynamic().can_sleep(false)
-        }
-        .translation(b.position)
-        .rotation(b.rotation.to_scaled_axis());
-        let (h, _) = world.insert(body, collider);
-        if !b.fixed {
-            handles.push(h);
-        }
-    }
-    (world, handles)
+    crate::rapier_boxes::rapier_boxes(specs, |_| 1000.0)
 }
 
 /// The top of a stack (highest box at the start) after 10 s, minus where it started (m).

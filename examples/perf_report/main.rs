@@ -13,6 +13,8 @@
 #[cfg(feature = "bevy")]
 mod bevy_layer;
 mod contacts;
+#[path = "../common/rapier_boxes.rs"]
+mod rapier_boxes;
 mod rigid;
 mod scenario;
 mod snapshot;

@@ -12,7 +12,11 @@
 //!    impulses from step to step by feature id (warm starting); contact start/end messages.
 //!    A pair that moved less than [`ContactSettings::recycle_distance`] relative to itself
 //!    since its manifolds were found keeps them and only updates their separations;
-//! 4. contact constraints with anchors, effective masses and the approach speed.
+//! 4. contact constraints with anchors, effective masses and the approach speed. A
+//!    manifold's normal and lever arms are taken when its points are found and held in the
+//!    world frame while it is reused, riding with each body's centre of mass (the separation
+//!    is still measured at the turned points): arms that turned with a leaning box swung its
+//!    support against the lean, and a column of 20 boxes toppled in 5 s.
 //!
 //! **Solver, every substep** (Box2D v3's soft step): after the velocities are integrated,
 //! the contacts are warm-started and solved with a soft position bias (spring of

@@ -8,7 +8,7 @@ use parry3d::math::Pose;
 use super::broad::BroadPhase;
 use super::exchange::Live;
 use super::fetch::Wanted;
-use super::narrow::Contacts;
+use super::narrow::{Contacts, FrozenGeometry, MAX_POINTS};
 use super::plugin::{part_pose, shape_pose};
 use super::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, SolverBody};
 use super::{Collider, ContactSettings, Friction, Restitution, RestitutionThreshold};
@@ -260,7 +260,7 @@ fn tangent_basis(
 pub(super) fn prepare_contacts(
     mut solver: ResMut<ContactSolver>,
     mut active: ResMut<ConstraintsActive>,
-    contacts: Res<Contacts>,
+    mut contacts: ResMut<Contacts>,
     bp: Res<BroadPhase>,
     settings: Res<ContactSettings>,
     bodies: Query<PreparedBody, (With<Collider>, Live)>,
@@ -294,8 +294,10 @@ pub(super) fn prepare_contacts(
                 });
         }
     }
+    // Freezing a manifold's geometry is bookkeeping, not a change anyone listens for.
+    let contacts = contacts.bypass_change_detection();
     for &(ea, eb, sa, sb) in pairs.iter() {
-        let Some(state) = contacts.pairs.get(&(ea, eb)) else {
+        let Some(state) = contacts.pairs.get_mut(&(ea, eb)) else {
             continue;
         };
         let (sa, sb) = (sa as usize, sb as usize);
@@ -312,7 +314,6 @@ pub(super) fn prepare_contacts(
             continue;
         };
         let ((va, wa), (vb, wb)) = ((a.v, a.w), (b.v, b.w));
-        let (pose_a, pose_b) = (&a.pose, &b.pose);
         let friction = settings.friction_rule.combine(a.friction, b.friction);
         let restitution = settings
             .restitution_rule
@@ -323,65 +324,38 @@ pub(super) fn prepare_contacts(
             (Some(x), None) | (None, Some(x)) => x,
             (None, None) => settings.restitution_threshold,
         };
-        for (mi, m) in state.solved().enumerate() {
+        for (mi, m) in state
+            .manifolds
+            .iter_mut()
+            .chain(state.cast.as_deref_mut())
+            .enumerate()
+        {
             if m.points.is_empty() {
                 continue;
             }
-            // A compound's manifold is in its part's frame; the part's pose in the compound
-            // comes with the manifold.
-            let (pose_a, pose_b) = (
-                part_pose(pose_a, m.subshape_pos1()),
-                part_pose(pose_b, m.subshape_pos2()),
-            );
-            let n = Vec3A::from(pose_a.rotation * m.local_n1);
+            if !m.data.frozen.set {
+                m.data.frozen = freeze(m, a, b, touch);
+            }
+            let f = &m.data.frozen;
+            let n = Vec3A::from(f.n);
             let first = s.inputs.len() as u32;
             let kept = m.data.kept();
-            let count = kept.len();
-            let mut mids = [Vec3A::ZERO; super::narrow::MAX_POINTS];
-            let mut witness = [(Vec3A::ZERO, Vec3A::ZERO); super::narrow::MAX_POINTS];
-            for ((mid, w), &k) in mids.iter_mut().zip(&mut witness).zip(kept) {
+            let t = tangent_basis(
+                n,
+                m,
+                a.x + Vec3A::from(f.centre[0]),
+                (a.x, va, wa),
+                (b.x, vb, wb),
+            );
+            for (&k, arms) in kept.iter().zip(&f.arms) {
                 let p = &m.points[usize::from(k)];
-                *w = (
-                    Vec3A::from(pose_a * p.local_p1),
-                    Vec3A::from(pose_b * p.local_p2),
-                );
-                *mid = 0.5 * (w.0 + w.1);
-            }
-            // A round side's points are anchored at its centre of curvature (see
-            // `Roundness`).
-            let (round_a, round_b) = (a.round.radius(m.subshape1), b.round.radius(m.subshape2));
-            let mids = &mids[..count];
-            // Friction acts at the kept points' centre; the twist's arm is their mean
-            // distance from it.
-            let middle = mids.iter().sum::<Vec3A>() / count as f32;
-            let t = tangent_basis(n, m, middle, (a.x, va, wa), (b.x, vb, wb));
-            let radius = mids.iter().map(|&p| (p - middle).length()).sum::<f32>() / count as f32;
-            for ((&k, &mid), &(w_a, w_b)) in kept.iter().zip(mids).zip(&witness) {
-                let p = &m.points[usize::from(k)];
-                // A touching point acts at the middle of its two witness points. A
-                // speculative one, with a gap still open, acts on each body where that body
-                // will touch: anchored in the gap, its lever arms were as long as the gap
-                // (metres for a fast body), and friction on them spun the body.
-                let (p_a, p_b) = if p.dist > touch {
-                    (w_a, w_b)
-                } else {
-                    (mid, mid)
-                };
-                let p_a = if round_a > 0.0 {
-                    w_a - n * round_a
-                } else {
-                    p_a
-                };
-                let p_b = if round_b > 0.0 {
-                    w_b + n * round_b
-                } else {
-                    p_b
-                };
-                let (r_a, r_b) = (p_a - a.x, p_b - b.x);
+                let (r_a, r_b) = (Vec3A::from(arms[0]), Vec3A::from(arms[1]));
                 let rel = (vb + wb.cross(r_b)) - (va + wa.cross(r_a));
                 s.inputs.push(PointInput {
                     r_a,
                     r_b,
+                    // The separation parry measured at the turned points, less what the
+                    // solver adds back from the frozen arms at the start of the step.
                     base: p.dist - n.dot(r_b - r_a),
                     n_imp: p.data.normal,
                     approach: n.dot(rel),
@@ -414,9 +388,9 @@ pub(super) fn prepare_contacts(
                 count: s.inputs.len() as u32 - first,
                 pair: (ea, eb),
                 manifold: mi as u32,
-                centre_a: middle - a.x,
-                centre_b: middle - b.x,
-                radius,
+                centre_a: Vec3A::from(f.centre[0]),
+                centre_b: Vec3A::from(f.centre[1]),
+                radius: f.radius,
                 t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
                 twist: m.data.twist,
             });
@@ -424,4 +398,60 @@ pub(super) fn prepare_contacts(
     }
     s.build();
     active.0 = !s.manifolds.is_empty();
+}
+
+/// The normal and lever arms of `m` at the present poses of `a` and `b` (see
+/// [`FrozenGeometry`]).
+fn freeze(m: &super::narrow::Manifold, a: &Side, b: &Side, touch: f32) -> FrozenGeometry {
+    // A compound's manifold is in its part's frame; the part's pose in the compound comes
+    // with the manifold.
+    let (pose_a, pose_b) = (
+        part_pose(&a.pose, m.subshape_pos1()),
+        part_pose(&b.pose, m.subshape_pos2()),
+    );
+    let n = Vec3A::from(pose_a.rotation * m.local_n1);
+    // A round side's points are anchored at its centre of curvature (see `Roundness`).
+    let (round_a, round_b) = (a.round.radius(m.subshape1), b.round.radius(m.subshape2));
+    let kept = m.data.kept();
+    let mut mids = [Vec3A::ZERO; MAX_POINTS];
+    let mut out = FrozenGeometry {
+        n: Vec3::from(n),
+        set: true,
+        ..FrozenGeometry::default()
+    };
+    for ((mid, arms), &k) in mids.iter_mut().zip(&mut out.arms).zip(kept) {
+        let p = &m.points[usize::from(k)];
+        let (w_a, w_b) = (
+            Vec3A::from(pose_a * p.local_p1),
+            Vec3A::from(pose_b * p.local_p2),
+        );
+        *mid = 0.5 * (w_a + w_b);
+        // A touching point acts at the middle of its two witness points. A speculative
+        // one, with a gap still open, acts on each body where that body will touch:
+        // anchored in the gap, its lever arms were as long as the gap (metres for a fast
+        // body), and friction on them spun the body.
+        let (p_a, p_b) = if p.dist > touch {
+            (w_a, w_b)
+        } else {
+            (*mid, *mid)
+        };
+        let p_a = if round_a > 0.0 {
+            w_a - n * round_a
+        } else {
+            p_a
+        };
+        let p_b = if round_b > 0.0 {
+            w_b + n * round_b
+        } else {
+            p_b
+        };
+        *arms = [Vec3::from(p_a - a.x), Vec3::from(p_b - b.x)];
+    }
+    // Friction acts at the kept points' centre; the twist's arm is their mean distance
+    // from it.
+    let mids = &mids[..kept.len()];
+    let middle = mids.iter().sum::<Vec3A>() / kept.len() as f32;
+    out.centre = [Vec3::from(middle - a.x), Vec3::from(middle - b.x)];
+    out.radius = mids.iter().map(|&p| (p - middle).length()).sum::<f32>() / kept.len() as f32;
+    out
 }
