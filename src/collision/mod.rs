@@ -14,9 +14,10 @@
 //!    since its manifolds were found keeps them and only updates their separations;
 //! 4. contact constraints with anchors, effective masses and the approach speed. A
 //!    manifold's normal and lever arms are taken when its points are found and held in the
-//!    world frame while it is reused, riding with each body's centre of mass (the separation
-//!    is still measured at the turned points): arms that turned with a leaning box swung its
-//!    support against the lean, and a column of 20 boxes toppled in 5 s.
+//!    world frame, riding with each body's centre of mass, until its points are found again
+//!    more than 2 cm away (the separation is still measured at the turned points): arms that
+//!    turned with a leaning box swung its support against the lean, and a column of 20 boxes
+//!    toppled in 5 s.
 //!
 //! **Solver, every substep** (Box2D v3's soft step): after the velocities are integrated,
 //! the contacts are warm-started and solved with a soft position bias (spring of

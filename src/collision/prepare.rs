@@ -333,8 +333,9 @@ pub(super) fn prepare_contacts(
             if m.points.is_empty() {
                 continue;
             }
-            if !m.data.frozen.set {
-                m.data.frozen = freeze(m, a, b, touch);
+            let f = &m.data.frozen;
+            if !f.set || f.stale {
+                m.data.frozen = f.refresh(freeze(m, a, b, touch));
             }
             let f = &m.data.frozen;
             let n = Vec3A::from(f.n);
@@ -416,6 +417,7 @@ fn freeze(m: &super::narrow::Manifold, a: &Side, b: &Side, touch: f32) -> Frozen
     let mut mids = [Vec3A::ZERO; MAX_POINTS];
     let mut out = FrozenGeometry {
         n: Vec3::from(n),
+        count: kept.len() as u8,
         set: true,
         ..FrozenGeometry::default()
     };
