@@ -489,6 +489,45 @@ mod tests {
         // the window it is found again.
         assert!(!reach(10.0).holds(&now, extent, prediction, bound - 1e-5));
     }
+
+    fn geometry(shift: f32, count: u8) -> FrozenGeometry {
+        let mut g = FrozenGeometry {
+            n: Vec3::Y,
+            count,
+            set: true,
+            ..FrozenGeometry::default()
+        };
+        for (i, arms) in g.arms.iter_mut().take(usize::from(count)).enumerate() {
+            let x = if i % 2 == 0 { -0.5 } else { 0.5 } + shift;
+            *arms = [Vec3::new(x, 0.5, 0.5), Vec3::new(x, -0.5, 0.5)];
+        }
+        g
+    }
+
+    #[test]
+    fn frozen_geometry_is_kept_through_small_moves_and_retaken_past_the_tolerance() {
+        let old = FrozenGeometry {
+            stale: true,
+            ..geometry(0.0, 4)
+        };
+        let kept = old.refresh(geometry(0.015, 4));
+        assert_eq!(kept.arms, old.arms);
+        assert!(!kept.stale && kept.set);
+        let moved = geometry(0.025, 4);
+        assert_eq!(old.refresh(moved), moved);
+        // A point more or fewer, a turned normal, or nothing frozen yet: the new geometry.
+        assert_eq!(old.refresh(geometry(0.0, 3)), geometry(0.0, 3));
+        let turned = FrozenGeometry {
+            n: Vec3::new(0.03, 1.0, 0.0).normalize(),
+            ..geometry(0.0, 4)
+        };
+        assert_eq!(old.refresh(turned), turned);
+        let unset = FrozenGeometry {
+            set: false,
+            ..geometry(0.0, 4)
+        };
+        assert_eq!(unset.refresh(moved), moved);
+    }
 }
 
 /// One pair's state as a snapshot holds it (see [`crate::snapshot`]).
