@@ -54,25 +54,7 @@ fn ours(specs: &[BoxSpec], densities: &[f32], s: Stiffness) -> Outcome {
     w.insert_resource(hooke::PhysicsTime::new(1.0 / 60.0, s.substeps).unwrap());
     w.resource_mut::<hooke::SleepSettings>().enabled = false;
     w.resource_mut::<hooke::ContactSettings>().hertz = s.hertz;
-    let mut boxes = Vec::new();
-    for (i, b) in specs.iter().enumerate() {
-        let c = Collider::cuboid(b.half.x, b.half.y, b.half.z).unwrap();
-        if b.fixed {
-            w.spawn((
-                hooke::RigidBodyBundle::fixed(b.position, b.rotation).unwrap(),
-                c,
-            ));
-        } else {
-            let props = hooke::MassProperties::from_shape(&**c.shape(), densities[i]).unwrap();
-            let body = hooke::RigidBodyBundle::dynamic(props)
-                .unwrap()
-                .at(b.position)
-                .unwrap()
-                .with_rotation(b.rotation)
-                .unwrap();
-            boxes.push(w.spawn((body, c)).id());
-        }
-    }
+    let boxes = scenes::spawn_boxes_with_density(&mut w, specs, |i| densities[i]).unwrap();
     let top = top_of(specs);
     let start = specs.iter().filter(|b| !b.fixed).nth(top).unwrap().position;
     let (mut strayed, mut out_of_plane) = (0.0f32, 0.0f32);

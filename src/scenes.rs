@@ -172,33 +172,34 @@ pub fn tumbling_boxes(world: &mut World, n: usize) -> Result<()> {
 /// # Errors
 /// None in practice.
 pub fn ground(world: &mut World) -> Result<Entity> {
-    spawn_box(world, &BoxSpec::ground())
+    spawn_box(world, &BoxSpec::ground(), 1000.0)
 }
 
 /// Spawns `collider` at `position` and `rotation`: static when `fixed`, otherwise a dynamic
-/// body of density 1000 kg/m³. Every scene's bodies come through here.
+/// body of `density` (kg/m³). Every scene's bodies come through here.
 fn spawn_body(
     world: &mut World,
     collider: crate::Collider,
     position: Vec3,
     rotation: glam::Quat,
     fixed: bool,
+    density: f32,
 ) -> Result<Entity> {
     if fixed {
         return Ok(world
             .spawn((crate::RigidBodyBundle::fixed(position, rotation)?, collider))
             .id());
     }
-    let props = crate::MassProperties::from_shape(&**collider.shape(), 1000.0)?;
+    let props = crate::MassProperties::from_shape(&**collider.shape(), density)?;
     let body = crate::RigidBodyBundle::dynamic(props)?
         .at(position)?
         .with_rotation(rotation)?;
     Ok(world.spawn((body, collider)).id())
 }
 
-fn spawn_box(world: &mut World, b: &BoxSpec) -> Result<Entity> {
+fn spawn_box(world: &mut World, b: &BoxSpec, density: f32) -> Result<Entity> {
     let collider = crate::Collider::cuboid(b.half.x, b.half.y, b.half.z)?;
-    spawn_body(world, collider, b.position, b.rotation, b.fixed)
+    spawn_body(world, collider, b.position, b.rotation, b.fixed, density)
 }
 
 /// A dynamic box with half extents `half` (m) and density 1000 kg/m³ at `x`.
@@ -206,7 +207,7 @@ fn spawn_box(world: &mut World, b: &BoxSpec) -> Result<Entity> {
 /// # Errors
 /// Constructor errors for bad sizes.
 pub fn dynamic_box(world: &mut World, half: Vec3, x: Vec3) -> Result<Entity> {
-    spawn_box(world, &BoxSpec::dynamic(half, x))
+    spawn_box(world, &BoxSpec::dynamic(half, x), 1000.0)
 }
 
 /// A dynamic ball of radius `r` (m), density 1000 kg/m³, at `x`.
@@ -220,6 +221,7 @@ pub fn dynamic_ball(world: &mut World, r: f32, x: Vec3) -> Result<Entity> {
         x,
         glam::Quat::IDENTITY,
         false,
+        1000.0,
     )
 }
 
@@ -263,9 +265,21 @@ impl BoxSpec {
 /// # Errors
 /// Constructor errors for bad sizes.
 pub fn spawn_boxes(world: &mut World, specs: &[BoxSpec]) -> Result<Vec<Entity>> {
+    spawn_boxes_with_density(world, specs, |_| 1000.0)
+}
+
+/// [`spawn_boxes`], the dynamic box of spec `i` of density `density(i)` (kg/m³).
+///
+/// # Errors
+/// Constructor errors for bad sizes or densities.
+pub fn spawn_boxes_with_density(
+    world: &mut World,
+    specs: &[BoxSpec],
+    density: impl Fn(usize) -> f32,
+) -> Result<Vec<Entity>> {
     let mut out = Vec::new();
-    for b in specs {
-        let e = spawn_box(world, b)?;
+    for (i, b) in specs.iter().enumerate() {
+        let e = spawn_box(world, b, density(i))?;
         if !b.fixed {
             out.push(e);
         }
@@ -464,18 +478,8 @@ pub fn squeeze_densities(ratio: f32) -> [f32; 4] {
 pub fn squeeze(world: &mut World, ratio: f32) -> Result<[Entity; 3]> {
     crate::error::positive("mass ratio", ratio)?;
     let rho = squeeze_densities(ratio);
-    let mut out = [Entity::PLACEHOLDER; 3];
-    for (i, b) in squeeze_spec().iter().enumerate() {
-        if b.fixed {
-            spawn_box(world, b)?;
-            continue;
-        }
-        let collider = crate::Collider::cuboid(b.half.x, b.half.y, b.half.z)?;
-        let props = crate::MassProperties::from_shape(&**collider.shape(), rho[i])?;
-        let body = crate::RigidBodyBundle::dynamic(props)?.at(b.position)?;
-        out[i - 1] = world.spawn((body, collider)).id();
-    }
-    Ok(out)
+    let boxes = spawn_boxes_with_density(world, &squeeze_spec(), |i| rho[i])?;
+    Ok([boxes[0], boxes[1], boxes[2]])
 }
 
 /// A soft beam along x from 0 to `length` (m), square `side` (m), meshed `cells` (6 tets a

@@ -44,41 +44,38 @@ fn soft_sink(n: usize, omega: f32) -> f32 {
     9.81 / (omega * omega) * (n / 4.0 + n * (n - 1.0))
 }
 
+/// Runs a column of `n` boxes at the default settings for `seconds` and checks that its top
+/// sank the soft contacts' closed form within `rel` of it and strayed less than `stray` m.
+fn stands_at_the_defaults(n: usize, seconds: f32, rel: f32, stray: f32) {
+    let (sink, strayed) = column(n, 4, 60.0, seconds);
+    // The default 60 Hz is capped at an eighth of the 240 Hz substep rate: 30 Hz.
+    let expected = soft_sink(n, std::f32::consts::TAU * 30.0);
+    assert!(
+        (sink - expected).abs() < rel * expected,
+        "{n} boxes: sank {sink} m, the soft contacts' closed form {expected} m"
+    );
+    assert!(
+        strayed < stray,
+        "{n} boxes: the top strayed {strayed} m from the axis"
+    );
+}
+
 #[test]
 fn a_column_of_30_boxes_stands_at_the_default_settings() {
     // Before: 20 boxes toppled at 4.8 s, 30 at 5.0 s.
-    let (sink, strayed) = column(30, 4, 60.0, 20.0);
-    // The default 60 Hz is capped at an eighth of the 240 Hz substep rate: 30 Hz.
-    let expected = soft_sink(30, std::f32::consts::TAU * 30.0);
-    assert!(
-        (sink - expected).abs() < 0.02 * expected,
-        "sank {sink} m, the soft contacts' closed form {expected} m"
-    );
-    assert!(strayed < 0.15, "the top strayed {strayed} m from the axis");
+    stands_at_the_defaults(30, 20.0, 0.02, 0.15);
 }
 
 #[test]
 fn a_column_of_50_boxes_stands_at_the_default_settings() {
     // It fell at 6 s while the solver took each new manifold's geometry at once.
-    let (sink, strayed) = column(50, 4, 60.0, 20.0);
-    let expected = soft_sink(50, std::f32::consts::TAU * 30.0);
-    assert!(
-        (sink - expected).abs() < 0.01 * expected,
-        "sank {sink} m, the soft contacts' closed form {expected} m"
-    );
-    assert!(strayed < 0.45, "the top strayed {strayed} m from the axis");
+    stands_at_the_defaults(50, 20.0, 0.01, 0.45);
 }
 
 #[test]
 fn a_column_sinks_as_its_soft_contacts_predict() {
     for n in [10, 20] {
-        let (sink, strayed) = column(n, 4, 60.0, 10.0);
-        let expected = soft_sink(n, std::f32::consts::TAU * 30.0);
-        assert!(
-            (sink - expected).abs() < 0.02 * expected,
-            "{n} boxes: sank {sink} m, closed form {expected} m"
-        );
-        assert!(strayed < 0.1, "{n} boxes: strayed {strayed} m");
+        stands_at_the_defaults(n, 10.0, 0.02, 0.1);
     }
 }
 

@@ -42,7 +42,7 @@ pub(crate) struct ManifoldData {
 /// and fell by 15 s. With the arms fixed, the separation is still measured at the turned
 /// points (only the directions the impulses act along are held), and both stand (see
 /// `tests/issue_tall_stacks.rs`). Each arm rides with its body's centre of mass.
-#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
 pub(crate) struct FrozenGeometry {
     /// Normal from the first shape to the second (world frame).
     pub n: Vec3,
@@ -52,13 +52,25 @@ pub(crate) struct FrozenGeometry {
     pub centre: [Vec3; 2],
     /// Mean distance of the kept points from their centre (m): the twist friction's arm.
     pub radius: f32,
-    /// How many points the arms are for.
+    /// How many points the arms are for (none until the solver first reads the manifold).
     pub count: u8,
-    /// False until the solver first reads the manifold.
-    pub set: bool,
-    /// The manifold's points were found again since: the solver takes the new geometry
-    /// unless it is within [`FrozenGeometry::TOLERANCE`] of this one.
+    /// The manifold's points were found since: the solver takes the new geometry unless it
+    /// is within [`FrozenGeometry::TOLERANCE`] of this one.
     pub stale: bool,
+}
+
+impl Default for FrozenGeometry {
+    /// Nothing frozen yet, so the solver takes the manifold's geometry when it first reads it.
+    fn default() -> Self {
+        Self {
+            n: Vec3::ZERO,
+            arms: [[Vec3::ZERO; 2]; MAX_POINTS],
+            centre: [Vec3::ZERO; 2],
+            radius: 0.0,
+            count: 0,
+            stale: true,
+        }
+    }
 }
 
 impl FrozenGeometry {
@@ -69,12 +81,12 @@ impl FrozenGeometry {
     pub const TOLERANCE: f32 = 0.02;
 
     /// `fresh` if it differs from `self` by more than [`FrozenGeometry::TOLERANCE`] in any
-    /// arm or in the normal, or `self` was never set; else `self`, no longer stale.
+    /// arm or in the normal, or holds a different number of points (none when nothing was
+    /// frozen yet); else `self`, no longer stale.
     #[must_use]
     pub fn refresh(&self, fresh: Self) -> Self {
         let close = |a: Vec3, b: Vec3| (a - b).length_squared() <= Self::TOLERANCE.powi(2);
-        let keep = self.set
-            && self.count == fresh.count
+        let keep = self.count == fresh.count
             && close(self.n, fresh.n)
             && self
                 .arms
@@ -494,7 +506,7 @@ mod tests {
         let mut g = FrozenGeometry {
             n: Vec3::Y,
             count,
-            set: true,
+            stale: false,
             ..FrozenGeometry::default()
         };
         for (i, arms) in g.arms.iter_mut().take(usize::from(count)).enumerate() {
@@ -512,7 +524,7 @@ mod tests {
         };
         let kept = old.refresh(geometry(0.015, 4));
         assert_eq!(kept.arms, old.arms);
-        assert!(!kept.stale && kept.set);
+        assert!(!kept.stale && kept.count == 4);
         let moved = geometry(0.025, 4);
         assert_eq!(old.refresh(moved), moved);
         // A point more or fewer, a turned normal, or nothing frozen yet: the new geometry.
@@ -522,11 +534,7 @@ mod tests {
             ..geometry(0.0, 4)
         };
         assert_eq!(old.refresh(turned), turned);
-        let unset = FrozenGeometry {
-            set: false,
-            ..geometry(0.0, 4)
-        };
-        assert_eq!(unset.refresh(moved), moved);
+        assert_eq!(FrozenGeometry::default().refresh(moved), moved);
     }
 }
 
@@ -622,7 +630,7 @@ impl Contacts {
             // Geometry a snapshot holds that is not finite is taken again from the poses.
             for m in p.manifolds.iter_mut().chain(p.cast.as_mut()) {
                 if !m.data.frozen.is_finite() {
-                    m.data.frozen.set = false;
+                    m.data.frozen = FrozenGeometry::default();
                 }
             }
             let k = both((p.a, p.b))?;

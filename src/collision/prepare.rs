@@ -333,9 +333,8 @@ pub(super) fn prepare_contacts(
             if m.points.is_empty() {
                 continue;
             }
-            let f = &m.data.frozen;
-            if !f.set || f.stale {
-                m.data.frozen = f.refresh(freeze(m, a, b, touch));
+            if m.data.frozen.stale {
+                m.data.frozen = m.data.frozen.refresh(freeze(m, a, b, touch));
             }
             let f = &m.data.frozen;
             let n = Vec3A::from(f.n);
@@ -418,7 +417,7 @@ fn freeze(m: &super::narrow::Manifold, a: &Side, b: &Side, touch: f32) -> Frozen
     let mut out = FrozenGeometry {
         n: Vec3::from(n),
         count: kept.len() as u8,
-        set: true,
+        stale: false,
         ..FrozenGeometry::default()
     };
     for ((mid, arms), &k) in mids.iter_mut().zip(&mut out.arms).zip(kept) {
