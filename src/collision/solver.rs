@@ -233,6 +233,10 @@ struct Batch {
     threshold: F4,
     /// All-ones in lanes where one side is static: they use the stiffer static softness.
     fixed: F4,
+    /// Some lane bounces (restitution > 0): only then do the passes keep the record the
+    /// restitution reads (impact speeds, the energy the impulses took out); a batch without
+    /// restitution gives it nothing either way, so skipping it changes no result.
+    bouncy: bool,
 }
 
 /// The step's contact constraints and the bodies they touch.
@@ -387,6 +391,65 @@ impl Side {
     }
 }
 
+/// What a pass knows of one batch before it visits its points.
+struct Pass {
+    n: V3,
+    /// n·(Δx_b − Δx_a), and ΔRᵀn of each side: the separation's change is then two dot
+    /// products per point (n·(ΔR r) = (ΔRᵀn)·r).
+    shift: F4,
+    turn_a: V3,
+    turn_b: V3,
+    inv_h: F4,
+    bias_rate: F4,
+    mass_scale: F4,
+    impulse_scale: F4,
+    /// Minus the push-out speed limit (m/s).
+    max_push: F4,
+}
+
+impl Pass {
+    /// One point's normal impulse (see [`ContactSolver::solve`]); `TRACK` keeps the record
+    /// the restitution reads.
+    #[inline(always)]
+    fn point<const BIAS: bool, const TRACK: bool>(
+        &self,
+        p: &mut Point,
+        a: &mut Side,
+        b: &mut Side,
+    ) {
+        let zero = F4::ZERO;
+        let s = (self.shift + (self.turn_b.dot(p.r_b) - self.turn_a.dot(p.r_a))) + p.base;
+        let speculative = s.simd_gt(zero);
+        let bias = speculative.select(s * self.inv_h, (self.bias_rate * s).fast_max(self.max_push));
+        let m_scale = speculative.select(F4::ONE, self.mass_scale);
+        let i_scale = speculative.select(zero, self.impulse_scale);
+        let vn = self.n.dot(Side::relative(a, b, p.r_a, p.r_b));
+        if BIAS && TRACK {
+            p.vn_seen = [p.vn_seen[1], vn];
+        }
+        let imp = -p.normal.mass * m_scale * (vn + bias) - i_scale * p.n_imp;
+        let total = (p.n_imp + imp).fast_max(zero);
+        let imp = total - p.n_imp;
+        if TRACK {
+            let first = p.max_n.simd_eq(zero) & imp.simd_gt(zero);
+            if first.any() {
+                let hit = impact_speed(vn, s, p.vn_seen, self.inv_h);
+                p.approach = first.select(p.approach.fast_min(hit), p.approach);
+                p.vn_first = first.select(vn, p.vn_first);
+            }
+            p.max_n = p.max_n.fast_max(imp);
+            p.lost -= work(imp, vn, p.half_w);
+            if !BIAS {
+                // The relax pass is each substep's last: n_imp is that substep's impulse.
+                p.vn_end = vn + F4::splat(2.0) * imp * p.half_w;
+                p.absorbed += total;
+            }
+        }
+        p.n_imp = total;
+        Side::push(a, b, self.n, &p.normal, imp);
+    }
+}
+
 impl ContactSolver {
     /// Empties the solver for a new step.
     pub fn clear(&mut self) {
@@ -498,6 +561,9 @@ impl ContactSolver {
             restitution: scalar(|m| m.restitution),
             threshold: scalar(|m| -m.threshold),
             fixed: F4::new(fixed.map(|f| if f { f32::from_bits(!0) } else { 0.0 })),
+            bouncy: chunk
+                .iter()
+                .any(|&mi| self.manifolds[mi as usize].restitution > 0.0),
         };
         for k in 0..count {
             // Lanes past a manifold's last point stay zero (their masses are zeroed too).
@@ -668,7 +734,9 @@ impl ContactSolver {
                 // The velocity the last pass left stands in for the present one (they differ
                 // by the forces of one substep): the hot loop does not pay for another
                 // relative velocity per point.
-                p.lost -= work(p.n_imp, p.vn_end, p.half_w);
+                if batch.bouncy {
+                    p.lost -= work(p.n_imp, p.vn_end, p.half_w);
+                }
                 Side::push(a, b, batch.n, &p.normal, p.n_imp);
             }
             friction.warm_start(batch, a, b);
@@ -712,7 +780,7 @@ impl ContactSolver {
     ) {
         let inv_h = F4::splat(1.0 / h);
         let max_push = F4::splat(-max_push);
-        let (zero, one, two) = (F4::ZERO, F4::ONE, F4::splat(2.0));
+        let (zero, one) = (F4::ZERO, F4::ONE);
         self.for_each_batch(|batch, friction, points, states, [a, b]| {
             let (dx_a, dr_a) = Self::motion(states, batch.a);
             let (dx_b, dr_b) = Self::motion(states, batch.b);
@@ -735,35 +803,23 @@ impl ContactSolver {
                 dr_a.transpose_mul_vec(batch.n),
                 dr_b.transpose_mul_vec(batch.n),
             );
-            let shift = batch.n.dot(dx_b - dx_a);
+            let pass = Pass {
+                n: batch.n,
+                shift: batch.n.dot(dx_b - dx_a),
+                turn_a,
+                turn_b,
+                inv_h,
+                bias_rate,
+                mass_scale,
+                impulse_scale,
+                max_push,
+            };
             let mut visit = |p: &mut Point| {
-                let s = (shift + (turn_b.dot(p.r_b) - turn_a.dot(p.r_a))) + p.base;
-                let speculative = s.simd_gt(zero);
-                let bias = speculative.select(s * inv_h, (bias_rate * s).fast_max(max_push));
-                let m_scale = speculative.select(one, mass_scale);
-                let i_scale = speculative.select(zero, impulse_scale);
-                let vn = batch.n.dot(Side::relative(a, b, p.r_a, p.r_b));
-                if BIAS {
-                    p.vn_seen = [p.vn_seen[1], vn];
+                if batch.bouncy {
+                    pass.point::<BIAS, true>(p, a, b);
+                } else {
+                    pass.point::<BIAS, false>(p, a, b);
                 }
-                let imp = -p.normal.mass * m_scale * (vn + bias) - i_scale * p.n_imp;
-                let total = (p.n_imp + imp).fast_max(zero);
-                let imp = total - p.n_imp;
-                let first = p.max_n.simd_eq(zero) & imp.simd_gt(zero);
-                if first.any() {
-                    let hit = impact_speed(vn, s, p.vn_seen, inv_h);
-                    p.approach = first.select(p.approach.fast_min(hit), p.approach);
-                    p.vn_first = first.select(vn, p.vn_first);
-                }
-                p.n_imp = total;
-                p.max_n = p.max_n.fast_max(imp);
-                p.lost -= work(imp, vn, p.half_w);
-                if !BIAS {
-                    // The relax pass is each substep's last: n_imp is that substep's impulse.
-                    p.vn_end = vn + two * imp * p.half_w;
-                    p.absorbed += total;
-                }
-                Side::push(a, b, batch.n, &p.normal, imp);
             };
             if BIAS {
                 points.iter_mut().for_each(&mut visit);

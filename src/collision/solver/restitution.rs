@@ -25,7 +25,8 @@ impl ContactSolver {
         // The budget: e² of the energy lost, and of what the impact-speed extrapolation adds
         // to an impact (the speed the substep's integration had not reached yet).
         let mut budget = 0.0f32;
-        for batch in batches.iter() {
+        // A batch that does not bounce kept no record (see `Batch::bouncy`) and adds nothing.
+        for batch in batches.iter().filter(|b| b.bouncy) {
             let e2 = batch.restitution * batch.restitution;
             for p in &points[batch.first as usize..(batch.first + batch.count) as usize] {
                 let hit = p.approach.simd_lt(batch.threshold) & p.max_n.simd_gt(zero);
@@ -38,11 +39,8 @@ impl ContactSolver {
                 budget += (e2 * (p.lost + extra)).reduce_add();
             }
         }
-        for batch in batches.iter() {
+        for batch in batches.iter().filter(|b| b.bouncy) {
             let bouncy = batch.restitution.simd_gt(zero);
-            if !bouncy.any() {
-                continue;
-            }
             let (mut a, mut b) = (
                 Self::load(states, batch.a, batch.inv_m_a),
                 Self::load(states, batch.b, batch.inv_m_b),
