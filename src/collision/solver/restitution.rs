@@ -70,8 +70,9 @@ impl ContactSolver {
                 p.n_imp += imp;
                 Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
             }
-            Self::store(states, rest, batch.a, &a);
-            Self::store(states, rest, batch.b, &b);
+            Self::store(states, batch.a, &a);
+            Self::store(states, batch.b, &b);
+            Self::settle_rest(states, rest);
         }
     }
 }
