@@ -233,10 +233,17 @@ struct Batch {
     threshold: F4,
     /// All-ones in lanes where one side is static: they use the stiffer static softness.
     fixed: F4,
-    /// Some lane bounces (restitution > 0): only then do the passes keep the record the
-    /// restitution reads (impact speeds, the energy the impulses took out); a batch without
-    /// restitution gives it nothing either way, so skipping it changes no result.
-    bouncy: bool,
+}
+
+impl Batch {
+    /// Some lane bounces (restitution > 0; empty lanes hold 0): only then do the passes
+    /// keep the record the restitution reads (impact speeds, the energy the impulses took
+    /// out). A batch without restitution gives it nothing either way, so skipping it
+    /// changes no result.
+    #[inline]
+    fn bouncy(&self) -> bool {
+        self.restitution.simd_gt(F4::ZERO).any()
+    }
 }
 
 /// The step's contact constraints and the bodies they touch.
@@ -561,9 +568,6 @@ impl ContactSolver {
             restitution: scalar(|m| m.restitution),
             threshold: scalar(|m| -m.threshold),
             fixed: F4::new(fixed.map(|f| if f { f32::from_bits(!0) } else { 0.0 })),
-            bouncy: chunk
-                .iter()
-                .any(|&mi| self.manifolds[mi as usize].restitution > 0.0),
         };
         for k in 0..count {
             // Lanes past a manifold's last point stay zero (their masses are zeroed too).
@@ -741,11 +745,12 @@ impl ContactSolver {
     /// Applies every accumulated impulse once (warm start).
     pub fn warm_start(&mut self) {
         self.for_each_batch(|batch, friction, points, _, [a, b]| {
+            let bouncy = batch.bouncy();
             for p in points.iter_mut() {
                 // The velocity the last pass left stands in for the present one (they differ
                 // by the forces of one substep): the hot loop does not pay for another
                 // relative velocity per point.
-                if batch.bouncy {
+                if bouncy {
                     p.lost -= work(p.n_imp, p.vn_end, p.half_w);
                 }
                 Side::push(a, b, batch.n, &p.normal, p.n_imp);
@@ -825,8 +830,9 @@ impl ContactSolver {
                 impulse_scale,
                 max_push,
             };
+            let bouncy = batch.bouncy();
             let mut visit = |p: &mut Point| {
-                if batch.bouncy {
+                if bouncy {
                     pass.point::<BIAS, true>(p, a, b);
                 } else {
                     pass.point::<BIAS, false>(p, a, b);

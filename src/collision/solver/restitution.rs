@@ -26,7 +26,7 @@ impl ContactSolver {
         // to an impact (the speed the substep's integration had not reached yet).
         let mut budget = 0.0f32;
         // A batch that does not bounce kept no record (see `Batch::bouncy`) and adds nothing.
-        for batch in batches.iter().filter(|b| b.bouncy) {
+        for batch in batches.iter().filter(|b| b.bouncy()) {
             let e2 = batch.restitution * batch.restitution;
             for p in &points[batch.first as usize..(batch.first + batch.count) as usize] {
                 let hit = p.approach.simd_lt(batch.threshold) & p.max_n.simd_gt(zero);
@@ -39,7 +39,7 @@ impl ContactSolver {
                 budget += (e2 * (p.lost + extra)).reduce_add();
             }
         }
-        for batch in batches.iter().filter(|b| b.bouncy) {
+        for batch in batches.iter().filter(|b| b.bouncy()) {
             let bouncy = batch.restitution.simd_gt(zero);
             let (mut a, mut b) = (
                 Self::load(states, batch.a, batch.inv_m_a),
