@@ -164,3 +164,26 @@ fn a_frozen_body_becomes_an_immovable_obstacle() {
     assert!(!s.bodies[0].dynamic);
     assert_eq!(s.states[s.rest() as usize].v, Vec3A::ZERO);
 }
+
+#[test]
+fn a_spent_restitution_budget_never_scales_an_impulse_up() {
+    use super::restitution::budget_share;
+    // The case that blew up a struck row: the budget was −2.65 J and an impulse that took
+    // 7.7 mJ out was scaled by 344; the next point's by 64.
+    assert_eq!(budget_share(-0.0077, -2.65), 1.0);
+    assert_eq!(budget_share(-603.0, -38_480.0), 1.0);
+    // An impulse that adds energy gets what is left of the budget, none once it is spent.
+    assert_eq!(budget_share(4.0, 1.0), 0.25);
+    assert_eq!(budget_share(2.0, -1.0), 0.0);
+    assert_eq!(budget_share(1.0, 3.0), 1.0);
+    for (cost, budget) in [
+        (-5.0, -1.0),
+        (-1.0, -5.0),
+        (3.0, -2.0),
+        (0.5, 0.2),
+        (0.0, -1.0),
+    ] {
+        let share = budget_share(cost, budget);
+        assert!((0.0..=1.0).contains(&share), "{cost} {budget}: {share}");
+    }
+}
