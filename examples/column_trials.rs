@@ -15,19 +15,13 @@ use hooke::scenes::{self, BoxSpec};
 mod rapier_boxes;
 
 /// A column of `n` boxes, each moved sideways by up to `offset` m, from seed `run`.
-fn column(n: usize, offset: f32, run: u64) -> Vec<BoxSpec> {
+fn column(n: usize, offset: f32, run: usize) -> Vec<BoxSpec> {
     let mut specs = scenes::column_spec(n);
-    let mut state = (run + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15);
-    let mut unit = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
-    };
     // The first spec is the ground.
-    for s in specs.iter_mut().skip(1) {
-        s.position.x += offset * unit();
-        s.position.z += offset * unit();
+    for (i, s) in specs.iter_mut().enumerate().skip(1) {
+        let d = scenes::jitter(run * (n + 1) + i) * offset;
+        s.position.x += d.x;
+        s.position.z += d.z;
     }
     specs
 }
@@ -75,7 +69,7 @@ fn main() {
         .unwrap_or(1e-4);
     let rapier = std::env::var("RAPIER").is_ok();
     let steps = seconds * 60;
-    let mut strays: Vec<f32> = (0..runs as u64)
+    let mut strays: Vec<f32> = (0..runs)
         .map(|run| {
             let specs = column(n, offset, run);
             if rapier {

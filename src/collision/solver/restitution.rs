@@ -87,9 +87,7 @@ impl ContactSolver {
 /// wanted 35 N·s scaled by 64).
 #[must_use]
 pub(super) fn budget_share(cost: f32, budget: f32) -> f32 {
-    if cost <= budget.max(0.0) || cost <= 0.0 {
-        1.0
-    } else {
-        budget.max(0.0) / cost
-    }
+    let left = budget.max(0.0);
+    // Past the test, cost > left ≥ 0.
+    if cost <= left { 1.0 } else { left / cost }
 }
