@@ -241,7 +241,14 @@ fn write(
     }
     v.0 = state.v;
     if let Some(mut l) = l {
-        l.bypass_change_detection().0 += b.i0 * (state.w - b.w_in);
+        let dw = state.w - b.w_in;
+        // An isotropic body's tensor is an exact diagonal (see `Inertia::world_tensors`):
+        // the scalar product is the matrix product without its added zeros.
+        l.bypass_change_detection().0 += if b.isotropic {
+            b.i0.x_axis.x * dw
+        } else {
+            b.i0 * dw
+        };
     }
 }
 
