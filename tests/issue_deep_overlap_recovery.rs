@@ -88,7 +88,10 @@ fn check(name: &str, r: &Recovery, lowest_allowed: f32) {
 
 #[test]
 fn a_thousand_boxes_spawned_at_one_point_spread_into_a_heap_on_the_ground() {
-    let r = heap_at_one_point(1000, 0.0, 10.0);
+    // 12 s: the heap stands 4 m high, and a box near its top may still slip down late (one
+    // did at 9.5–10.5 s, at up to 1.3 m/s, once the solver took each face's corners in one
+    // order); every box was asleep by 11.5 s.
+    let r = heap_at_one_point(1000, 0.0, 12.0);
     check("1000 boxes at one point", &r, -0.4);
 }
 

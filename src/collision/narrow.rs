@@ -74,20 +74,39 @@ impl Default for FrozenGeometry {
 }
 
 impl FrozenGeometry {
-    /// How far (m, and in the normal's direction) a manifold's geometry may have moved
-    /// when its points are found again before the solver takes the new one. Taking it at
-    /// every full update (every 5 mm of relative motion at the defaults) turned the arms
-    /// with a leaning body in steps, and a column of 50 boxes fell.
+    /// How far (m) a manifold's geometry may have moved across the normal (and how far its
+    /// normal may have turned, in radians) when its points are found again before the
+    /// solver takes the new one. Taking it at every full update (every 5 mm of relative
+    /// motion at the defaults) turned the arms with a leaning body in steps, and a column of
+    /// 50 boxes fell.
     pub const TOLERANCE: f32 = 0.02;
 
-    /// `fresh` if it differs from `self` by more than [`FrozenGeometry::TOLERANCE`] in any
-    /// arm or in the normal, or holds a different number of points (none when nothing was
-    /// frozen yet); else `self`, no longer stale.
+    /// How far (m) a point may have moved along the normal, against its bodies' centres,
+    /// before the solver takes the new geometry: the soft contacts' compression. The joints
+    /// of a 100-box column at the defaults compress by up to 5 cm (their points' middles
+    /// move half that against each centre) as the column settles; taken anew at 2 cm, each
+    /// joint at its own step, the arms of the lower joints turned the column, and it fell.
+    /// Across the normal the tolerance stays 2 cm: at 5 cm every way, a box rocking on an
+    /// edge pushed on arms up to 5 cm from where it touched, and kept rocking (the top
+    /// three crates of a knocked-out tower, for seconds).
+    pub const COMPRESSION_TOLERANCE: f32 = 0.05;
+
+    /// `fresh` if one of its arms moved more than [`FrozenGeometry::TOLERANCE`] across
+    /// the normal or more than [`FrozenGeometry::COMPRESSION_TOLERANCE`] along it, its
+    /// normal turned more than [`FrozenGeometry::TOLERANCE`], or it holds a different number
+    /// of points (none when nothing was frozen yet); else `self`, no longer stale.
     #[must_use]
     pub fn refresh(&self, fresh: Self) -> Self {
-        let close = |a: Vec3, b: Vec3| (a - b).length_squared() <= Self::TOLERANCE.powi(2);
-        let keep = self.count == fresh.count
-            && close(self.n, fresh.n)
+        let (across, along) = (Self::TOLERANCE, Self::COMPRESSION_TOLERANCE);
+        let n = fresh.n;
+        let close = |a: Vec3, b: Vec3| {
+            let d = a - b;
+            let dn = d.dot(n);
+            (d - dn * n).length_squared() <= across * across && dn.abs() <= along
+        };
+        let turned = (self.n - fresh.n).length_squared() > across * across;
+        let keep = !turned
+            && self.count == fresh.count
             && self
                 .arms
                 .iter()
@@ -207,13 +226,54 @@ pub(crate) fn choose_points(m: &mut Manifold, scratch: &mut Vec<(Vec3A, f32, boo
     }));
     // The choice only measures distances in the contact plane, so it is made in the first
     // shape's (or part's) frame.
-    let (keep, count) = keep_points(scratch, Vec3A::from(m.local_n1));
+    let (mut keep, count) = keep_points(scratch, Vec3A::from(m.local_n1));
+    solve_order(&mut keep[..count], m);
     for (k, &i) in m.data.kept.iter_mut().zip(&keep[..count]) {
         // parry's manifolds hold far fewer than 256 points.
         *k = i as u8;
     }
     m.data.kept_len = count as u8;
     m.data.frozen.stale = true;
+}
+
+/// Puts the kept points of `m` in the order the solver visits them: around their centre,
+/// counterclockwise in the contact plane, from the same direction of that plane every time.
+///
+/// Why: the order decides which way a pass leaves a face contact tilted (the corners solved
+/// first take more of the impulse). parry lists a clipped face's corners around it, but
+/// from a vertex that differs from one pair to the next, so each joint of a column tilted
+/// its own way, and the tilts grew into buckling: a column of 100 unit boxes fell at the
+/// defaults, and with every box moved up to 0.1 mm sideways none of 8 stood. Started from
+/// the same direction, every joint tilts alike, the column leans a little as a whole and
+/// stands (8 of 8 with those offsets, each top 0.16 m off the axis; 5 of 8 columns of 150;
+/// with [`FrozenGeometry::COMPRESSION_TOLERANCE`]). Sorted along one axis and then the other
+/// instead (as rapier 0.36 does), the corners were no longer taken around the face: a
+/// cube landing flat slid and tipped, and the symmetric relax sweep (see the solver) lost
+/// its point.
+fn solve_order(keep: &mut [usize], m: &Manifold) {
+    if keep.len() < 2 {
+        return;
+    }
+    let (u, v) = m.local_n1.any_orthonormal_pair();
+    let n = keep.len() as f32;
+    let centre = keep.iter().map(|&i| m.points[i].local_p1).sum::<Vec3>() / n;
+    let angle = |i: usize| {
+        let d = m.points[i].local_p1 - centre;
+        d.dot(v).atan2(d.dot(u))
+    };
+    keep.sort_unstable_by(|&x, &y| angle(x).total_cmp(&angle(y)));
+}
+
+/// The normal impulse of the points of `m` the solver took (N·s). The others hold what
+/// parry carried over to them by feature, which may be from a step long ago.
+#[must_use]
+pub(crate) fn kept_normal_impulse(m: &Manifold) -> f32 {
+    m.data
+        .kept()
+        .iter()
+        .filter_map(|&k| m.points.get(usize::from(k)))
+        .map(|p| p.data.normal)
+        .sum()
 }
 
 /// Which of a manifold's points to solve when it has more than [`MAX_POINTS`]: the deepest,
@@ -356,13 +416,13 @@ impl Contacts {
         for m in &s.manifolds {
             // A compound's manifold is in its part's frame.
             let part = m.subshape_pos1().copied().unwrap_or_default();
+            out.normal_impulse += kept_normal_impulse(m);
             for p in &m.points {
                 out.points.push(part * p.local_p1);
                 if -p.dist > out.depth || out.normal == Vec3::ZERO {
                     out.depth = out.depth.max(-p.dist);
                     out.normal = part.rotation * m.local_n1;
                 }
-                out.normal_impulse += p.data.normal;
             }
         }
         Some(out)
@@ -461,6 +521,63 @@ mod tests {
         assert_eq!(unique.len(), count);
     }
 
+    /// A unit box face on another, clipped as parry clips it: each corner twice, once as a
+    /// vertex of either box, listed around the face.
+    fn clipped_face() -> Manifold {
+        use parry3d::query::TrackedContact;
+        use parry3d::shape::PackedFeatureId;
+        let mut m = Manifold::new();
+        m.local_n1 = Vec3::Y;
+        let corners = [(0.5, 0.5), (-0.5, 0.5), (-0.5, -0.5), (0.5, -0.5)];
+        for copy in 0..2u32 {
+            for (i, &(x, z)) in corners.iter().enumerate() {
+                let p = Vec3::new(x, 0.5, z);
+                let fid = PackedFeatureId::vertex(copy * 4 + i as u32);
+                m.points
+                    .push(TrackedContact::new(p, p - Vec3::Y, fid, fid, -0.01));
+            }
+        }
+        m
+    }
+
+    #[test]
+    fn the_solver_takes_a_face_around_it_from_the_same_side_whatever_parry_listed_first() {
+        let mut orders = Vec::new();
+        // parry's list, and the same list started from each other corner.
+        for start in 0..4 {
+            let mut m = clipped_face();
+            m.points.rotate_left(start);
+            choose_points(&mut m, &mut Vec::new());
+            let corners: Vec<Vec3> = m
+                .data
+                .kept()
+                .iter()
+                .map(|&k| m.points[usize::from(k)].local_p1)
+                .collect();
+            assert_eq!(corners.len(), 4);
+            // Around the face: each corner shares an edge with the next.
+            for (a, b) in corners.iter().zip(corners.iter().cycle().skip(1)) {
+                let d = (*a - *b).abs();
+                assert!(d.x < 1e-6 || d.z < 1e-6, "{corners:?}");
+            }
+            orders.push(corners);
+        }
+        assert!(orders.windows(2).all(|w| w[0] == w[1]), "{orders:?}");
+    }
+
+    #[test]
+    fn a_manifold_impulse_counts_only_the_points_solved() {
+        let mut m = clipped_face();
+        choose_points(&mut m, &mut Vec::new());
+        let kept: Vec<usize> = m.data.kept().iter().map(|&k| usize::from(k)).collect();
+        // The solver wrote this step's impulses into the points it took; the others hold
+        // what parry carried over from a step when they were taken.
+        for (i, p) in m.points.iter_mut().enumerate() {
+            p.data.normal = if kept.contains(&i) { 10.0 } else { 99.0 };
+        }
+        assert_eq!(kept_normal_impulse(&m), 40.0);
+    }
+
     #[test]
     fn the_drift_bound_covers_every_point_of_the_moved_shape_and_no_more() {
         let half = Vec3::new(0.5, 0.3, 0.2);
@@ -522,19 +639,42 @@ mod tests {
             stale: true,
             ..geometry(0.0, 4)
         };
-        let kept = old.refresh(geometry(0.015, 4));
+        let tol = FrozenGeometry::TOLERANCE;
+        let kept = old.refresh(geometry(0.75 * tol, 4));
         assert_eq!(kept.arms, old.arms);
         assert!(!kept.stale && kept.count == 4);
-        let moved = geometry(0.025, 4);
+        let moved = geometry(1.25 * tol, 4);
         assert_eq!(old.refresh(moved), moved);
         // A point more or fewer, a turned normal, or nothing frozen yet: the new geometry.
         assert_eq!(old.refresh(geometry(0.0, 3)), geometry(0.0, 3));
         let turned = FrozenGeometry {
-            n: Vec3::new(0.03, 1.0, 0.0).normalize(),
+            n: Vec3::new(1.5 * tol, 1.0, 0.0).normalize(),
             ..geometry(0.0, 4)
         };
         assert_eq!(old.refresh(turned), turned);
         assert_eq!(FrozenGeometry::default().refresh(moved), moved);
+    }
+
+    #[test]
+    fn frozen_geometry_is_kept_through_a_compression_deeper_than_the_tolerance_across() {
+        let old = geometry(0.0, 4);
+        // Along the normal (y), as a settling column's contacts compress.
+        let along = |d: f32| {
+            let mut g = geometry(0.0, 4);
+            for arms in &mut g.arms {
+                arms[0].y -= d;
+                arms[1].y += d;
+            }
+            g
+        };
+        let (tol, deep) = (
+            FrozenGeometry::TOLERANCE,
+            FrozenGeometry::COMPRESSION_TOLERANCE,
+        );
+        assert!(deep > 2.0 * tol);
+        assert_eq!(old.refresh(along(2.0 * tol)).arms, old.arms);
+        let pressed = along(1.25 * deep);
+        assert_eq!(old.refresh(pressed), pressed);
     }
 }
 

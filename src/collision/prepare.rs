@@ -244,7 +244,7 @@ fn tangent_basis(
 ) -> [Vec3A; 2] {
     let slide = (vb + wb.cross(centre - xb)) - (va + wa.cross(centre - xa));
     let impulse = Vec3A::from(m.data.tangent);
-    let normal: f32 = m.points.iter().map(|p| p.data.normal).sum();
+    let normal = super::narrow::kept_normal_impulse(m);
     let along = |v: Vec3A| (v - n * n.dot(v)).try_normalize();
     // Only a clear signal picks the direction: below it (a body at rest under a small
     // sideways load) a noisy direction would turn the basis from step to step, and a fixed

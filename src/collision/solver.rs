@@ -198,9 +198,11 @@ struct Point {
     half_w: F4,
     /// The relative normal velocity the last pass left (for the next warm start's work).
     vn_end: F4,
-    /// The relative normal velocity when the point first pushed this step; `approach`
-    /// extrapolates the impact speed past it.
-    vn_first: F4,
+    /// What extrapolating the impact speed at the point's first push added to the square of
+    /// its normal velocity (m²/s²): the restitution's budget credits this much kinetic
+    /// energy, and nothing for a start-of-step `approach` faster than the first push (other
+    /// contacts' impulses slowed the pair in between, and their work is already counted).
+    gain: F4,
 }
 
 /// The kinetic energy an impulse λ along a point's normal adds to its two bodies, with vn
@@ -442,7 +444,7 @@ impl Pass {
             if first.any() {
                 let hit = impact_speed(vn, s, p.vn_seen, self.inv_h);
                 p.approach = first.select(p.approach.fast_min(hit), p.approach);
-                p.vn_first = first.select(vn, p.vn_first);
+                p.gain = first.select(hit * hit - vn * vn, p.gain);
             }
             p.max_n = p.max_n.fast_max(imp);
             p.lost -= work(imp, vn, p.half_w);
@@ -596,7 +598,7 @@ impl ContactSolver {
                 lost: F4::ZERO,
                 half_w: F4::ZERO,
                 vn_end: F4::ZERO,
-                vn_first: F4::ZERO,
+                gain: F4::ZERO,
             });
         }
         self.friction

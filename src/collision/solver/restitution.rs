@@ -34,7 +34,7 @@ impl ContactSolver {
                     .half_w
                     .simd_gt(zero)
                     .select(F4::splat(0.25) / p.half_w, zero);
-                let extra = m * (p.approach * p.approach - p.vn_first * p.vn_first);
+                let extra = m * p.gain;
                 let extra = hit.select(extra.fast_max(zero), zero);
                 budget += (e2 * (p.lost + extra)).reduce_add();
             }
