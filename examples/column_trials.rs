@@ -14,18 +14,6 @@ use hooke::scenes::{self, BoxSpec};
 #[path = "common/rapier_boxes.rs"]
 mod rapier_boxes;
 
-/// A column of `n` boxes, each moved sideways by up to `offset` m, from seed `run`.
-fn column(n: usize, offset: f32, run: usize) -> Vec<BoxSpec> {
-    let mut specs = scenes::column_spec(n);
-    // The first spec is the ground.
-    for (i, s) in specs.iter_mut().enumerate().skip(1) {
-        let d = scenes::jitter(run * (n + 1) + i) * offset;
-        s.position.x += d.x;
-        s.position.z += d.z;
-    }
-    specs
-}
-
 /// The farthest the top strayed from the axis over `steps` steps (m), in hooke.
 fn hooke_stray(specs: &[BoxSpec], steps: usize) -> f32 {
     let mut w = World::new();
@@ -71,7 +59,7 @@ fn main() {
     let steps = seconds * 60;
     let mut strays: Vec<f32> = (0..runs)
         .map(|run| {
-            let specs = column(n, offset, run);
+            let specs = scenes::perturbed_column_spec(n, offset, run);
             if rapier {
                 rapier_stray(&specs, steps)
             } else {

@@ -447,6 +447,21 @@ pub fn column_spec(n: usize) -> Vec<BoxSpec> {
     out
 }
 
+/// [`column_spec`] with every box moved sideways (x and z) by up to `offset` m, seeded by
+/// `run`: the same run gives the same column. One straight column standing can be luck;
+/// these ask how often (`examples/column_trials.rs`, `tests/issue_tall_stacks.rs`).
+#[must_use]
+pub fn perturbed_column_spec(n: usize, offset: f32, run: usize) -> Vec<BoxSpec> {
+    let mut specs = column_spec(n);
+    // The first spec is the ground.
+    for (i, s) in specs.iter_mut().enumerate().skip(1) {
+        let d = jitter(run * (n + 1) + i) * offset;
+        s.position.x += d.x;
+        s.position.z += d.z;
+    }
+    specs
+}
+
 /// [`column_spec`], spawned; returns the boxes, bottom first.
 ///
 /// # Errors

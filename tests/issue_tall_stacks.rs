@@ -87,16 +87,10 @@ fn a_column_of_100_boxes_stands_20_s_at_the_default_settings() {
 }
 
 /// Whether a column of `n` boxes, each moved sideways by up to `offset` m (run `run` of
-/// `examples/column_trials.rs`, which seeds the same offsets), keeps its top within half a
-/// box of the axis for `seconds` at the default settings.
+/// `examples/column_trials.rs`), keeps its top within half a box of the axis for `seconds`
+/// at the default settings.
 fn perturbed_column_stands(n: usize, offset: f32, run: usize, seconds: f32) -> bool {
-    let mut specs = scenes::column_spec(n);
-    // The first spec is the ground.
-    for (i, s) in specs.iter_mut().enumerate().skip(1) {
-        let d = scenes::jitter(run * (n + 1) + i) * offset;
-        s.position.x += d.x;
-        s.position.z += d.z;
-    }
+    let specs = scenes::perturbed_column_spec(n, offset, run);
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
     w.resource_mut::<hooke::SleepSettings>().enabled = false;

@@ -257,11 +257,17 @@ fn solve_order(keep: &mut [usize], m: &Manifold) {
     let (u, v) = m.local_n1.any_orthonormal_pair();
     let n = keep.len() as f32;
     let centre = keep.iter().map(|&i| m.points[i].local_p1).sum::<Vec3>() / n;
-    let angle = |i: usize| {
+    // One angle per point, not two per comparison.
+    let mut by_angle = [(0.0f32, 0usize); MAX_POINTS];
+    let by_angle = &mut by_angle[..keep.len()];
+    for (slot, &i) in by_angle.iter_mut().zip(keep.iter()) {
         let d = m.points[i].local_p1 - centre;
-        d.dot(v).atan2(d.dot(u))
-    };
-    keep.sort_unstable_by(|&x, &y| angle(x).total_cmp(&angle(y)));
+        *slot = (d.dot(v).atan2(d.dot(u)), i);
+    }
+    by_angle.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+    for (k, &(_, i)) in keep.iter_mut().zip(by_angle.iter()) {
+        *k = i;
+    }
 }
 
 /// The normal impulse of the points of `m` the solver took (N·s). The others hold what
