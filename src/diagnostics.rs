@@ -22,7 +22,7 @@ use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, rotational_energy};
 use crate::schedule::{
     FinishSystems, PhysicsSchedule, PhysicsSystems, ProbeSystems, StepSystems, SubstepSchedule,
-    add_systems,
+    add_own_systems,
 };
 use crate::springs::{Endpoint, Spinning, Spring, SpringNetwork, anchor_state, spring_energy};
 
@@ -67,7 +67,11 @@ pub struct PhysicsDiagnostics {
     /// Entity counts.
     pub counts: BodyCounts,
     /// Wall time per [`StepSystems`] set, in `StepSystems::ORDER`, summed over substeps.
+    /// Zero after a step on the whole-step path, which has no sets.
     pub set_times: [Duration; 9],
+    /// Whether the last step ran its substeps on the whole-step path (see
+    /// [`crate::whole_step`]) instead of through [`crate::SubstepSchedule`].
+    pub whole_step: bool,
     /// Wall time of the whole last step.
     pub step_time: Duration,
     /// Bodies quarantined since the world started.
@@ -131,7 +135,7 @@ pub(crate) fn install(world: &mut World) {
     crate::restore::init::<DiagnosticsSettings>(world);
     crate::restore::init::<SetClock>(world);
     for k in 0..=9u8 {
-        add_systems(
+        add_own_systems(
             world,
             SubstepSchedule,
             // The setting is checked inside: a run condition would cost as much as the probe.
@@ -148,7 +152,7 @@ pub(crate) fn install(world: &mut World) {
             .in_set(ProbeSystems(k)),
         );
     }
-    add_systems(
+    add_own_systems(
         world,
         PhysicsSchedule,
         (

@@ -167,6 +167,7 @@ pub mod soft;
 pub mod springs;
 pub mod testing;
 pub mod time;
+pub mod whole_step;
 
 /// parry, re-exported so custom shapes ([`Collider::new`]) need no second dependency.
 pub use parry3d;
@@ -209,6 +210,7 @@ pub use springs::{
     SpringStability, StabilityPolicy, StabilityWarning,
 };
 pub use time::{FrameReport, PhysicsTime, SubstepTime};
+pub use whole_step::FusedSubsteps;
 
 /// Everything a game needs in scope.
 pub mod prelude {
@@ -261,20 +263,21 @@ impl WorldPlugin for PhysicsCorePlugin {
         restore::init::<PhysicsTime>(world);
         restore::init::<Messages<restore::ResourceRestored>>(world);
         restore::init::<Messages<restore::InvalidSetting>>(world);
-        schedule::add_systems(
+        schedule::add_own_systems(
             world,
             PhysicsSchedule,
             restore::restore_resources.in_set(PhysicsSystems::Restore),
         );
-        schedule::add_systems(
+        schedule::add_own_systems(
             world,
             PhysicsSchedule,
             quarantine::quarantine_runaway_velocities.in_set(schedule::PrepareSystems::Guard),
         );
         crate::restore::init::<SubstepTime>(world);
+        crate::restore::init::<FusedSubsteps>(world);
         crate::restore::init::<Messages<BodyQuarantined>>(world);
         crate::restore::init::<quarantine::DivergenceGuard>(world);
-        schedule::add_systems(
+        schedule::add_own_systems(
             world,
             PhysicsSchedule,
             time::run_substeps::<AnyBody>.in_set(PhysicsSystems::Step),

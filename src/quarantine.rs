@@ -306,7 +306,7 @@ pub(crate) fn quarantine_runaway_velocities(
 
 /// Adds [`validate_changed`] for `T` to the step (effects call it for their cold components).
 pub(crate) fn validate_writes<T: Component + Validate>(world: &mut World) {
-    crate::schedule::add_systems(
+    crate::schedule::add_own_systems(
         world,
         crate::schedule::PhysicsSchedule,
         validate_changed::<T>

@@ -313,6 +313,46 @@ pub(crate) fn init_schedules(world: &mut World) {
     schedules.insert(forces);
 }
 
+/// How many of [`SubstepSchedule`]'s systems hooke's own plugins added. A schedule holding
+/// more has game systems in its substeps, which the whole-step path (see
+/// [`crate::whole_step`]) would skip.
+#[derive(Resource, Debug, Default)]
+pub(crate) struct OwnSubstepSystems(pub usize);
+
+fn substep_systems(world: &World) -> usize {
+    world
+        .get_resource::<Schedules>()
+        .and_then(|s| s.get(SubstepSchedule))
+        .map_or(0, Schedule::systems_len)
+}
+
+/// [`add_systems`] for hooke's own plugins: systems put into [`SubstepSchedule`] are counted
+/// in [`OwnSubstepSystems`].
+pub(crate) fn add_own_systems<M>(
+    world: &mut World,
+    label: impl ScheduleLabel,
+    systems: impl IntoScheduleConfigs<ScheduleSystem, M>,
+) {
+    let counted = label.intern() == SubstepSchedule.intern();
+    let before = substep_systems(world);
+    add_systems(world, label, systems);
+    if counted {
+        let added = substep_systems(world).saturating_sub(before);
+        world.get_resource_or_init::<OwnSubstepSystems>().0 += added;
+    }
+}
+
+/// [`add_force_systems`] for hooke's own plugins (counted like [`add_own_systems`]).
+pub(crate) fn add_own_force_systems<M, S>(world: &mut World, systems: impl Fn() -> S)
+where
+    S: IntoScheduleConfigs<ScheduleSystem, M>,
+{
+    let before = substep_systems(world);
+    add_force_systems(world, systems);
+    let added = substep_systems(world).saturating_sub(before);
+    world.get_resource_or_init::<OwnSubstepSystems>().0 += added;
+}
+
 /// Adds force systems to both the substep and the stage re-evaluation schedule.
 ///
 /// `systems` is called once per schedule, so each schedule owns its own system state. Place

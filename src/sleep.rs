@@ -29,7 +29,7 @@ use crate::rigid::{
     AngularMomentum, AngularVelocity, ExternalForceAtPoint, ExternalImpulseAtPoint, ExternalTorque,
     Rotation,
 };
-use crate::schedule::{CollisionSystems, PhysicsSchedule, PrepareSystems, add_systems};
+use crate::schedule::{CollisionSystems, PhysicsSchedule, PrepareSystems, add_own_systems};
 use crate::springs::Spring;
 use crate::time::PhysicsTime;
 
@@ -66,7 +66,7 @@ pub struct SleepPlugin;
 impl WorldPlugin for SleepPlugin {
     fn build(&self, world: &mut World) {
         crate::restore::init::<SleepSettings>(world);
-        add_systems(
+        add_own_systems(
             world,
             PhysicsSchedule,
             (
@@ -78,7 +78,7 @@ impl WorldPlugin for SleepPlugin {
                 .run_if(any_with_component::<Collider>)
                 .in_set(PrepareSystems::Sleep),
         );
-        add_systems(
+        add_own_systems(
             world,
             PhysicsSchedule,
             wake_hit_islands

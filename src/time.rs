@@ -189,10 +189,20 @@ pub(crate) fn run_substeps<Bodies: bevy_ecs::query::QueryFilter>(
     world: &mut World,
     bodies: &mut QueryState<(), Bodies>,
 ) {
+    if !world.contains_resource::<PhysicsTime>() {
+        return;
+    }
+    let empty = bodies.iter(world).next().is_none();
+    if !empty && crate::whole_step::try_whole_step(world) {
+        if let Some(mut time) = world.get_resource_mut::<PhysicsTime>() {
+            time.elapsed += f64::from(time.dt);
+            time.steps += 1;
+        }
+        return;
+    }
     let Some(time) = world.get_resource::<PhysicsTime>() else {
         return;
     };
-    let empty = bodies.iter(world).next().is_none();
     let (n, h, t0) = (time.substeps, time.substep_dt(), time.elapsed);
     // One lookup of the schedule for all substeps. The core plugin creates it; a missing
     // one means a user removed it, and the step then does nothing.

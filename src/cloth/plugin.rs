@@ -7,8 +7,8 @@ use super::Cloth;
 use crate::particles::{Nodes, VelocityField};
 use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::schedule::{
-    FinishSystems, ForceSystems, PhysicsSchedule, RelaxSystems, SubstepSchedule, add_force_systems,
-    add_systems,
+    FinishSystems, ForceSystems, PhysicsSchedule, RelaxSystems, SubstepSchedule,
+    add_own_force_systems, add_own_systems,
 };
 use crate::springs::SpringNetwork;
 use crate::time::PhysicsTime;
@@ -30,12 +30,13 @@ pub struct ClothPlugin;
 
 impl WorldPlugin for ClothPlugin {
     fn build(&self, world: &mut World) {
-        add_force_systems(world, || {
+        crate::whole_step::block_on::<Cloth>(world);
+        add_own_force_systems(world, || {
             apply_wind
                 .run_if(any_with_component::<Cloth>)
                 .in_set(ForceSystems::Damping)
         });
-        add_systems(
+        add_own_systems(
             world,
             SubstepSchedule,
             (
@@ -47,7 +48,7 @@ impl WorldPlugin for ClothPlugin {
                 .chain()
                 .in_set(RelaxSystems::Cloth),
         );
-        add_systems(
+        add_own_systems(
             world,
             PhysicsSchedule,
             update_normals

@@ -166,31 +166,57 @@ fn read(
     (_, x, q, v, l, w): bevy_ecs::query::ROQueryItem<'_, '_, SolvedBody<'_>>,
     frozen: &mut Vec<u32>,
 ) {
+    read_values(
+        solver,
+        i,
+        x.0,
+        q.0,
+        v.0,
+        l.map(|l| &l.0),
+        w.map(|w| &w.0),
+        frozen,
+    );
+}
+
+/// [`read`] from plain values: solver body `i` at position `x`, rotation `q`, velocity `v`,
+/// angular momentum `l` (none for a body without inertia) and stored ω `w`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)] // one body's state, field by field
+pub(super) fn read_values(
+    solver: &mut ContactSolver,
+    i: usize,
+    x: Vec3A,
+    q: glam::Quat,
+    v: Vec3A,
+    l: Option<&Vec3A>,
+    w: Option<&Vec3A>,
+    frozen: &mut Vec<u32>,
+) {
     let b = &mut solver.bodies[i];
     // Between a relax pass and the next substep's biased pass only renormalisation turns a
     // body, by a rounding: ΔR formed at the last turn still holds (to 2e-6 rad at most, as
     // it is always compared with the rotation it was formed at).
-    let dr = if (q.0 - b.q_seen).length_squared() <= SAME_TURN {
+    let dr = if (q - b.q_seen).length_squared() <= SAME_TURN {
         solver.states[i].dr
     } else {
-        b.q_seen = q.0;
-        Mat3A::from_quat(q.0 * b.q0.inverse())
+        b.q_seen = q;
+        Mat3A::from_quat(q * b.q0.inverse())
     };
     let w = match l {
-        Some(l) if b.dynamic && b.isotropic => b.inv_i.x_axis.x * l.0,
-        Some(l) if b.dynamic => dr * (b.inv_i * (dr.transpose() * l.0)),
-        _ => w.map_or(Vec3A::ZERO, |w| w.0),
+        Some(&l) if b.dynamic && b.isotropic => b.inv_i.x_axis.x * l,
+        Some(&l) if b.dynamic => dr * (b.inv_i * (dr.transpose() * l)),
+        _ => w.copied().unwrap_or(Vec3A::ZERO),
     };
     let state = BodyState {
-        v: v.0,
+        v,
         w,
-        dx: x.0 - b.x0,
+        dx: x - b.x0,
         dr,
     };
     b.w_in = w;
     // One test of three lane masks, not three branches.
     let finite = (state.v.is_finite_mask() & w.is_finite_mask() & state.dx.is_finite_mask()).all()
-        && q.0.is_finite();
+        && q.is_finite();
     if finite || !b.dynamic {
         solver.states[i] = if finite { state } else { BodyState::REST };
     } else {
@@ -241,14 +267,34 @@ fn write(
     }
     v.0 = state.v;
     if let Some(mut l) = l {
-        let dw = state.w - b.w_in;
-        // An isotropic body's tensor is an exact diagonal (see `Inertia::world_tensors`):
-        // the scalar product is the matrix product without its added zeros.
-        l.bypass_change_detection().0 += if b.isotropic {
-            b.i0.x_axis.x * dw
-        } else {
-            b.i0 * dw
-        };
+        l.bypass_change_detection().0 += angular_impulse(b, state);
+    }
+}
+
+/// I₀ Δω, the angular impulse of a pass.
+#[inline(always)]
+fn angular_impulse(b: &super::solver::SolverBody, state: &BodyState) -> Vec3A {
+    let dw = state.w - b.w_in;
+    // An isotropic body's tensor is an exact diagonal (see `Inertia::world_tensors`): the
+    // scalar product is the matrix product without its added zeros.
+    if b.isotropic {
+        b.i0.x_axis.x * dw
+    } else {
+        b.i0 * dw
+    }
+}
+
+/// [`write`] to plain values: v ← the solved v, L += I₀ Δω. Nothing for a body that is not
+/// dynamic.
+#[inline(always)]
+pub(super) fn write_values(solver: &ContactSolver, i: usize, v: &mut Vec3A, l: Option<&mut Vec3A>) {
+    let (b, state) = (&solver.bodies[i], &solver.states[i]);
+    if !b.dynamic {
+        return;
+    }
+    *v = state.v;
+    if let Some(l) = l {
+        *l += angular_impulse(b, state);
     }
 }
 

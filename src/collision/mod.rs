@@ -63,6 +63,7 @@ mod ccd;
 pub(crate) mod coupling;
 mod exchange;
 mod fetch;
+pub(crate) mod fused;
 mod lanes;
 mod narrow;
 pub(crate) mod nodes;

@@ -18,7 +18,7 @@ use crate::particles::{LinearVelocity, Position};
 use crate::rest::Sleeping;
 use crate::rigid::{AngularVelocity, CenterOfMass, Rotation};
 use crate::schedule::{
-    CollisionSystems, PhysicsSchedule, StepSystems, SubstepSchedule, add_systems,
+    CollisionSystems, PhysicsSchedule, StepSystems, SubstepSchedule, add_own_systems,
 };
 use crate::time::{PhysicsTime, SubstepTime};
 
@@ -30,7 +30,8 @@ pub struct CollisionPlugin;
 impl WorldPlugin for CollisionPlugin {
     fn build(&self, world: &mut World) {
         crate::restore::init::<ContactSettings>(world);
-        add_systems(
+        super::fused::install(world);
+        add_own_systems(
             world,
             PhysicsSchedule,
             (
@@ -47,7 +48,7 @@ impl WorldPlugin for CollisionPlugin {
         crate::restore::init::<bevy_ecs::message::Messages<ContactEnded>>(world);
         // Impulses from mesh nodes (soft bodies, cloth) reach their bodies at the start of the
         // next substep, before the bodies' own integrators.
-        add_systems(
+        add_own_systems(
             world,
             crate::schedule::SubstepSchedule,
             super::coupling::apply_node_impulses
@@ -59,14 +60,14 @@ impl WorldPlugin for CollisionPlugin {
         world.add_observer(super::attach::on_body_inserted);
         world.add_observer(super::attach::on_child_of_discarded);
         world.add_observer(super::attach::on_child_of_inserted);
-        add_systems(
+        add_own_systems(
             world,
             PhysicsSchedule,
             super::attach::place_attached_colliders
                 .run_if(any_with_component::<super::ColliderOf>)
                 .in_set(crate::schedule::FinishSystems::Writeback),
         );
-        add_systems(
+        add_own_systems(
             world,
             PhysicsSchedule,
             (
@@ -85,7 +86,7 @@ impl WorldPlugin for CollisionPlugin {
             )
                 .run_if(any_with_component::<Collider>.or_else(has_contacts)),
         );
-        add_systems(
+        add_own_systems(
             world,
             SubstepSchedule,
             (
@@ -572,14 +573,23 @@ fn solve_contacts(
     mut bodies: Query<SolvedBody, Live>,
 ) {
     gather(&mut solver, &bodies);
+    biased_pass(&mut solver, &time, &settings);
+    scatter(&mut solver, &mut bodies);
+}
+
+/// The solver's work in [`solve_contacts`], between its gather and its scatter.
+pub(super) fn biased_pass(
+    solver: &mut ContactSolver,
+    time: &SubstepTime,
+    settings: &ContactSettings,
+) {
     solver.limit_rotation(settings.max_rotation / time.h);
     solver.record_speeds();
-    let (soft, fixed) = softness(&settings, time.h);
+    let (soft, fixed) = softness(settings, time.h);
     solver.warm_start();
     solver.solve(time.h, soft, fixed, true, settings.max_push_velocity);
     solver.solve_grounded(time.h, soft, fixed, true, settings.max_push_velocity);
     solver.limit_deep_speed(settings.max_push_velocity);
-    scatter(&mut solver, &mut bodies);
 }
 
 /// One pass without bias; after the last substep, restitution and the impulses kept for
@@ -592,7 +602,18 @@ fn relax_contacts(
     mut bodies: Query<SolvedBody, Live>,
 ) {
     gather(&mut solver, &bodies);
-    let (soft, fixed) = softness(&settings, time.h);
+    relax_pass(&mut solver, &mut contacts, &time, &settings);
+    scatter(&mut solver, &mut bodies);
+}
+
+/// The solver's work in [`relax_contacts`], between its gather and its scatter.
+pub(super) fn relax_pass(
+    solver: &mut ContactSolver,
+    contacts: &mut Contacts,
+    time: &SubstepTime,
+    settings: &ContactSettings,
+) {
+    let (soft, fixed) = softness(settings, time.h);
     solver.solve(time.h, soft, fixed, false, settings.max_push_velocity);
     solver.solve_grounded(time.h, soft, fixed, false, settings.max_push_velocity);
     if time.is_last() {
@@ -624,7 +645,6 @@ fn relax_contacts(
             tracked.data.twist = solved.twist;
         }
     }
-    scatter(&mut solver, &mut bodies);
 }
 
 /// Settings written with bad values (NaN, negative) are put back to their defaults, field by

@@ -13,7 +13,7 @@ use crate::rigid::{
     AngularMomentum, CenterOfMass, ExternalImpulseAtPoint, ExternalTorque, Inertia, Rotation,
     Torque, world_point,
 };
-use crate::schedule::{IntegrationSystems, StepSystems, add_force_systems, add_systems};
+use crate::schedule::{IntegrationSystems, StepSystems, add_own_force_systems, add_own_systems};
 use crate::time::SubstepTime;
 use crate::{SubstepSchedule, WorldPlugin};
 
@@ -41,8 +41,13 @@ impl WorldPlugin for IntegratorPlugin {
     fn build(&self, world: &mut World) {
         crate::restore::init::<Integrator>(world);
         crate::restore::init::<ConstraintsActive>(world);
-        add_force_systems(world, || clear_forces.in_set(StepSystems::ClearForces));
-        add_systems(
+        // The whole-step path integrates rigid bodies only, with constant forces.
+        crate::whole_step::block_on::<ExternalImpulse>(world);
+        crate::whole_step::block_on::<ExternalImpulseAtPoint>(world);
+        crate::whole_step::block_on::<IntegratorOverride>(world);
+        crate::whole_step::block_on::<Nodes>(world);
+        add_own_force_systems(world, || clear_forces.in_set(StepSystems::ClearForces));
+        add_own_systems(
             world,
             SubstepSchedule,
             (

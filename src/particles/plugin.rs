@@ -8,7 +8,9 @@ use super::{Force, LinearDamping, LinearVelocity, Mass, Position, Tracer};
 use crate::WorldPlugin;
 use crate::integrator::{advect_euler, advect_midpoint, advect_rk4};
 use crate::quarantine::{Quarantined, quarantine_non_finite};
-use crate::schedule::{ForceSystems, StepSystems, SubstepSchedule, add_force_systems, add_systems};
+use crate::schedule::{
+    ForceSystems, StepSystems, SubstepSchedule, add_own_force_systems, add_own_systems,
+};
 use crate::time::SubstepTime;
 
 /// Bodies the step moves: not quarantined, not asleep.
@@ -34,7 +36,8 @@ pub struct DampingPlugin;
 
 impl WorldPlugin for DampingPlugin {
     fn build(&self, world: &mut World) {
-        add_force_systems(world, || {
+        crate::whole_step::block_on::<LinearDamping>(world);
+        add_own_force_systems(world, || {
             apply_damping
                 .run_if(any_with_component::<LinearDamping>)
                 .in_set(ForceSystems::Damping)
@@ -55,7 +58,8 @@ pub struct VelocityFieldPlugin;
 impl WorldPlugin for VelocityFieldPlugin {
     fn build(&self, world: &mut World) {
         crate::restore::init::<Advection>(world);
-        add_systems(
+        crate::whole_step::block_on::<Tracer>(world);
+        add_own_systems(
             world,
             SubstepSchedule,
             advect_tracers

@@ -45,6 +45,7 @@ mod plugin;
 pub(crate) use mass::{ComputedMass, insert_computed_mass};
 pub use mass::{MassProperties, RigidBodyBundle, default_mass, parallel_axis};
 pub use plugin::RigidBodyPlugin;
+pub(crate) use plugin::turn;
 
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3, Vec3A};

@@ -14,7 +14,7 @@ use crate::particles::{Force, LinearVelocity, Position};
 use crate::quarantine::{Quarantined, quarantine_non_finite};
 use crate::schedule::{
     ForceSystems, IntegrationSystems, PhysicsSchedule, PrepareSystems, StepSystems,
-    SubstepSchedule, add_force_systems, add_systems,
+    SubstepSchedule, add_own_force_systems, add_own_systems,
 };
 use crate::time::{PhysicsTime, SubstepTime};
 
@@ -37,7 +37,10 @@ impl WorldPlugin for RigidBodyPlugin {
         crate::quarantine::validate_writes::<super::AngularDamping>(world);
         crate::quarantine::validate_writes::<super::KinematicTarget>(world);
         crate::restore::init::<Renormalization>(world);
-        add_systems(
+        crate::whole_step::block_on::<AngularDamping>(world);
+        crate::whole_step::block_on::<ExternalForceAtPoint>(world);
+        crate::whole_step::block_on::<SkipRenormalization>(world);
+        add_own_systems(
             world,
             PhysicsSchedule,
             (
@@ -47,7 +50,7 @@ impl WorldPlugin for RigidBodyPlugin {
                 .chain()
                 .in_set(PrepareSystems::Inputs),
         );
-        add_force_systems(world, || {
+        add_own_force_systems(world, || {
             (
                 apply_angular_damping
                     .run_if(any_with_component::<AngularDamping>)
@@ -57,7 +60,7 @@ impl WorldPlugin for RigidBodyPlugin {
                     .in_set(StepSystems::AccumulateTorque),
             )
         });
-        add_systems(
+        add_own_systems(
             world,
             SubstepSchedule,
             (
@@ -161,7 +164,7 @@ type AngularState<'a> = (
 /// One orientation step with L held: splitting for bodies with finite inertia, otherwise
 /// the chosen ω-held update (kinematic bodies turn at their set ω).
 #[inline]
-fn turn(
+pub(crate) fn turn(
     q: Quat,
     l: Vec3A,
     stored: Vec3A,

@@ -9,8 +9,8 @@ use crate::integrator::{ImplicitEuler, ImplicitState};
 use crate::particles::Nodes;
 use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::schedule::{
-    FinishSystems, ForceSystems, PhysicsSchedule, RelaxSystems, SubstepSchedule, add_force_systems,
-    add_systems,
+    FinishSystems, ForceSystems, PhysicsSchedule, RelaxSystems, SubstepSchedule,
+    add_own_force_systems, add_own_systems,
 };
 use crate::time::SubstepTime;
 
@@ -20,12 +20,16 @@ pub struct SoftBodyPlugin;
 
 impl WorldPlugin for SoftBodyPlugin {
     fn build(&self, world: &mut World) {
-        add_force_systems(world, || {
+        crate::whole_step::block_on::<SoftBody>(world);
+        crate::whole_step::block_on::<super::NodeAttachments>(world);
+        crate::whole_step::block_on::<super::NodeTargets>(world);
+        crate::whole_step::block_on::<ImplicitEuler>(world);
+        add_own_force_systems(world, || {
             apply_elastic_forces
                 .run_if(any_with_component::<SoftBody>)
                 .in_set(ForceSystems::Elasticity)
         });
-        add_systems(
+        add_own_systems(
             world,
             SubstepSchedule,
             solve_implicit
@@ -34,7 +38,7 @@ impl WorldPlugin for SoftBodyPlugin {
         );
         // Attachments first (chained: both move nodes), so that the contacts have the last
         // word on where a node may be.
-        add_systems(
+        add_own_systems(
             world,
             SubstepSchedule,
             (
@@ -47,7 +51,7 @@ impl WorldPlugin for SoftBodyPlugin {
                 .chain()
                 .in_set(RelaxSystems::Soft),
         );
-        add_systems(
+        add_own_systems(
             world,
             PhysicsSchedule,
             (
@@ -60,7 +64,7 @@ impl WorldPlugin for SoftBodyPlugin {
                 .chain()
                 .in_set(crate::schedule::PrepareSystems::Inputs),
         );
-        add_systems(
+        add_own_systems(
             world,
             PhysicsSchedule,
             report_elastic_energy

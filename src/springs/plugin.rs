@@ -11,7 +11,7 @@ use glam::Vec3;
 
 use crate::rigid::{AngularVelocity, Rotation, Torque};
 use crate::schedule::{
-    ForceSystems, PhysicsSchedule, PrepareSystems, add_force_systems, add_systems,
+    ForceSystems, PhysicsSchedule, PrepareSystems, add_own_force_systems, add_own_systems,
 };
 use crate::{Error, WorldPlugin};
 
@@ -24,7 +24,10 @@ pub struct SpringPlugin;
 
 impl WorldPlugin for SpringPlugin {
     fn build(&self, world: &mut World) {
-        add_force_systems(world, || {
+        crate::whole_step::block_on::<Spring>(world);
+        crate::whole_step::block_on::<SpringNetwork>(world);
+        crate::whole_step::block_on::<crate::integrator::ImplicitEuler>(world);
+        add_own_force_systems(world, || {
             (
                 apply_spring_forces.run_if(any_with_component::<Spring>),
                 apply_network_forces.run_if(any_with_component::<SpringNetwork>),
@@ -34,14 +37,14 @@ impl WorldPlugin for SpringPlugin {
         });
         // Substeps only: the multistage integrators' stage re-evaluations never see it (its
         // ends kick then drift).
-        add_systems(
+        add_own_systems(
             world,
             crate::schedule::SubstepSchedule,
             super::entity_implicit::solve_entity_springs
                 .run_if(any_with_component::<Spring>)
                 .in_set(ForceSystems::ImplicitSprings),
         );
-        add_systems(
+        add_own_systems(
             world,
             crate::schedule::SubstepSchedule,
             super::implicit::solve_implicit_springs
@@ -52,7 +55,7 @@ impl WorldPlugin for SpringPlugin {
         crate::restore::init::<super::entity_implicit::EntitySpringFactor>(world);
         crate::restore::init::<super::StabilityPolicy>(world);
         crate::restore::init::<bevy_ecs::message::Messages<super::StabilityWarning>>(world);
-        add_systems(
+        add_own_systems(
             world,
             PhysicsSchedule,
             (
