@@ -1,5 +1,6 @@
 //! Moving body state between the ECS and the contact solver: a gather before and a scatter
-//! after each of the two solver passes of a substep.
+//! after each of the two solver passes of a substep. (On the whole-step path the solver's
+//! bodies stay in arrays for the step, and [`read_values`] / [`write_values`] serve it.)
 //!
 //! A gather reads x, q, v and L and forms ω = ΔR I₀⁻¹ ΔRᵀ L (I(q)⁻¹ = ΔR I₀⁻¹ ΔRᵀ: three
 //! matrix products instead of the quaternion round trip through the principal frame). A
