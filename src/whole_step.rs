@@ -20,7 +20,8 @@
 //!   points, impulses, integrator overrides) registers the components its systems act on.
 //!
 //! The runner itself declines (and the schedule runs) for anything else it does not cover,
-//! such as a non-default integrator.
+//! such as a non-default integrator, and for steps of one substep, where loading and storing
+//! the bodies costs more than the schedule's round trips it saves.
 
 use bevy_ecs::component::ComponentId;
 use bevy_ecs::prelude::*;

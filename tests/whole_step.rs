@@ -181,6 +181,16 @@ fn effects_with_something_to_act_on_keep_the_schedule() {
 }
 
 #[test]
+fn one_substep_keeps_the_schedule() {
+    let mut world = World::new();
+    world.insert_resource(PhysicsTime::new(1.0 / 60.0, 1).unwrap());
+    world.add_physics(PhysicsPlugins);
+    scenes::spawn_boxes(&mut world, &scenes::box_stack_spec(2)).unwrap();
+    world.step_physics();
+    assert!(!world.resource::<PhysicsDiagnostics>().whole_step);
+}
+
+#[test]
 fn other_integrators_keep_the_schedule() {
     let mut world = World::new();
     world.add_physics(PhysicsPlugins);
