@@ -193,13 +193,8 @@ pub(crate) fn run_substeps<Bodies: bevy_ecs::query::QueryFilter>(
         return;
     }
     let empty = bodies.iter(world).next().is_none();
-    if !empty && crate::whole_step::try_whole_step(world) {
-        if let Some(mut time) = world.get_resource_mut::<PhysicsTime>() {
-            time.elapsed += f64::from(time.dt);
-            time.steps += 1;
-        }
-        return;
-    }
+    // An effect that ran the whole step leaves only the clock to advance.
+    let done = empty || crate::whole_step::try_whole_step(world);
     let Some(time) = world.get_resource::<PhysicsTime>() else {
         return;
     };
@@ -207,7 +202,7 @@ pub(crate) fn run_substeps<Bodies: bevy_ecs::query::QueryFilter>(
     // One lookup of the schedule for all substeps. The core plugin creates it; a missing
     // one means a user removed it, and the step then does nothing.
     let _ = world.try_schedule_scope(SubstepSchedule, |world, schedule| {
-        if empty {
+        if done {
             return;
         }
         for i in 0..n {

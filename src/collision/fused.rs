@@ -24,7 +24,7 @@ use super::exchange::{read_values, write_values};
 use super::narrow::Contacts;
 use super::plugin::{biased_pass, relax_pass};
 use super::solver::ContactSolver;
-use crate::integrator::{Integrator, drift, kick};
+use crate::integrator::{Integrator, constant_force, drift, kick};
 use crate::particles::{
     ExternalForce, Force, Gravity, GravityScale, LinearVelocity, Mass, Position,
 };
@@ -202,21 +202,6 @@ fn load(
         s.slot.push(at as u32);
     }
     found == solved
-}
-
-/// The force accumulator as `clear_forces` starts it every substep: f_ext + m g s.
-#[inline(always)]
-fn constant_force(
-    m: &Mass,
-    ext: Option<&ExternalForce>,
-    scale: Option<&GravityScale>,
-    g: Vec3A,
-) -> Vec3A {
-    match (ext, scale) {
-        (None, None) => m.force_scale() * g,
-        (None, Some(s)) => (m.force_scale() * s.0) * g,
-        (Some(ext), s) => Vec3A::from(ext.0) + (m.force_scale() * s.map_or(1.0, |s| s.0)) * g,
-    }
 }
 
 fn gather(solver: &mut ContactSolver, s: &mut Scratch) {

@@ -37,8 +37,8 @@ pub(crate) mod skyline;
 mod stages;
 
 pub use implicit::ImplicitReport;
-pub(crate) use plugin::mesh_divergence;
 pub use plugin::{ConstraintsActive, IntegratorPlugin};
+pub(crate) use plugin::{constant_force, mesh_divergence};
 
 /// Meshes the explicit integrators advance: alive, awake, and not solved implicitly.
 pub(crate) type ExplicitMesh = (

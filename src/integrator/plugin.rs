@@ -92,13 +92,12 @@ pub(crate) fn clear_forces(
     // this pass at raw-loop speed.
     plain
         .iter_mut()
-        .for_each(|(mut f, m)| f.bypass_change_detection().0 = m.force_scale() * g);
+        .for_each(|(mut f, m)| f.bypass_change_detection().0 = constant_force(m, None, None, g));
     scaled.iter_mut().for_each(|(mut f, m, s)| {
-        f.bypass_change_detection().0 = (m.force_scale() * s.0) * g;
+        f.bypass_change_detection().0 = constant_force(m, None, Some(s), g);
     });
     external.iter_mut().for_each(|(mut f, m, ext, s)| {
-        let s = s.map_or(1.0, |s| s.0);
-        f.bypass_change_detection().0 = Vec3A::from(ext.0) + (m.force_scale() * s) * g;
+        f.bypass_change_detection().0 = constant_force(m, Some(ext), s, g);
     });
     for mut nodes in &mut meshes {
         let n = nodes.bypass_change_detection();
@@ -113,6 +112,22 @@ pub(crate) fn clear_forces(
     external_torques
         .iter_mut()
         .for_each(|(mut t, e)| t.bypass_change_detection().0 = e.0);
+}
+
+/// A body's constant force f_ext + m g s, which every substep's accumulator starts from.
+#[must_use]
+#[inline(always)]
+pub(crate) fn constant_force(
+    m: &Mass,
+    ext: Option<&ExternalForce>,
+    scale: Option<&GravityScale>,
+    g: Vec3A,
+) -> Vec3A {
+    match (ext, scale) {
+        (None, None) => m.force_scale() * g,
+        (None, Some(s)) => (m.force_scale() * s.0) * g,
+        (Some(ext), s) => Vec3A::from(ext.0) + (m.force_scale() * s.map_or(1.0, |s| s.0)) * g,
+    }
 }
 
 /// Δv = J / m (and ΔL = r × J at a point), then J ← 0 without marking it changed, so the next
