@@ -19,6 +19,7 @@ impl ContactSolver {
         let Self {
             batches,
             points,
+            tracks,
             states,
             ..
         } = self;
@@ -28,15 +29,15 @@ impl ContactSolver {
         // A batch that does not bounce kept no record (see `Batch::bouncy`) and adds nothing.
         for batch in batches.iter().filter(|b| b.bouncy()) {
             let e2 = batch.restitution * batch.restitution;
-            for p in &points[batch.first as usize..(batch.first + batch.count) as usize] {
-                let hit = p.approach.simd_lt(batch.threshold) & p.max_n.simd_gt(zero);
-                let m = p
+            for t in &tracks[batch.first as usize..(batch.first + batch.count) as usize] {
+                let hit = t.approach.simd_lt(batch.threshold) & t.max_n.simd_gt(zero);
+                let m = t
                     .half_w
                     .simd_gt(zero)
-                    .select(F4::splat(0.25) / p.half_w, zero);
-                let extra = m * p.gain;
+                    .select(F4::splat(0.25) / t.half_w, zero);
+                let extra = m * t.gain;
                 let extra = hit.select(extra.fast_max(zero), zero);
-                budget += (e2 * (p.lost + extra)).reduce_add();
+                budget += (e2 * (t.lost + extra)).reduce_add();
             }
         }
         for batch in batches.iter().filter(|b| b.bouncy()) {
@@ -45,8 +46,9 @@ impl ContactSolver {
                 Self::load(states, batch.a, batch.inv_m_a),
                 Self::load(states, batch.b, batch.inv_m_b),
             );
-            for p in &mut points[batch.first as usize..(batch.first + batch.count) as usize] {
-                let hit = bouncy & p.approach.simd_lt(batch.threshold) & p.max_n.simd_gt(zero);
+            let range = batch.first as usize..(batch.first + batch.count) as usize;
+            for (p, t) in points[range.clone()].iter_mut().zip(&tracks[range]) {
+                let hit = bouncy & t.approach.simd_lt(batch.threshold) & t.max_n.simd_gt(zero);
                 if !hit.any() {
                     continue;
                 }
@@ -56,15 +58,15 @@ impl ContactSolver {
                 // not have stopped the approach by the step's end), then e times the whole
                 // compression impulse.
                 let finish = p.normal.mass * (-vn).fast_max(zero);
-                let poisson = finish + e * (p.absorbed + finish);
-                let wanted = (-p.normal.mass * (vn + e * p.approach)).fast_min(poisson);
+                let poisson = finish + e * (t.absorbed + finish);
+                let wanted = (-p.normal.mass * (vn + e * t.approach)).fast_min(poisson);
                 let total = hit.select((p.n_imp + wanted).fast_max(zero), p.n_imp);
                 let mut imp = total - p.n_imp;
                 // work(s λ) ≤ s work(λ) for s in [0, 1]: scaling by the budget's share keeps
                 // the sum within it.
-                let cost = work(imp, vn, p.half_w).reduce_add();
+                let cost = work(imp, vn, t.half_w).reduce_add();
                 imp *= F4::splat(budget_share(cost, budget));
-                budget -= work(imp, vn, p.half_w).reduce_add();
+                budget -= work(imp, vn, t.half_w).reduce_add();
                 p.n_imp += imp;
                 Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
             }
