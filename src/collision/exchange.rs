@@ -27,8 +27,23 @@ use crate::rigid::{AngularMomentum, AngularVelocity, Rotation};
 /// A query position that holds no solver body.
 const NONE: u32 = u32::MAX;
 
-/// Rotations closer than this (squared quaternion distance) share a ΔR.
-const SAME_TURN: f32 = 1e-12;
+/// How far a contact anchor may lag its body's turn when a pass reuses ΔR (m): about f32's
+/// resolution of a position 100 m from the origin.
+const ANCHOR_LAG: f32 = 1e-5;
+
+/// The squared quaternion distance within which a body of bounding radius `reach` (m)
+/// reuses its ΔR: a turn by θ moves a point r out by θ r, and θ ≈ 2 |Δq|. At least a
+/// rounding (1e-12, the limit before the tolerance), which sets it past a reach of 0.87 m:
+/// there the lag is up to 2e-6 rad times the reach.
+#[must_use]
+pub(super) fn same_turn(reach: f32) -> f32 {
+    let d = ANCHOR_LAG / (2.0 * reach);
+    if d.is_finite() {
+        (d * d).max(1e-12)
+    } else {
+        1e-12
+    }
+}
 
 /// A walk pays while at least this share of the query's bodies are in the solver.
 const WALK_SHARE: usize = 4;
@@ -194,10 +209,12 @@ pub(super) fn read_values(
     frozen: &mut Vec<u32>,
 ) {
     let b = &mut solver.bodies[i];
-    // Between a relax pass and the next substep's biased pass only renormalisation turns a
-    // body, by a rounding: ΔR formed at the last turn still holds (to 2e-6 rad at most, as
-    // it is always compared with the rotation it was formed at).
-    let dr = if (q - b.q_seen).length_squared() <= SAME_TURN {
+    // ΔR formed at a rotation this close still holds: always compared with the rotation it
+    // was formed at, it lags by at most `ANCHOR_LAG` at the body's reach. Between a relax
+    // pass and the next substep's biased pass only renormalisation turns a body, by a
+    // rounding; a body at rest turns by less than that lag for many substeps (in a 50-row
+    // pyramid three reads in four formed ΔR again at a rounding's tolerance).
+    let dr = if (q - b.q_seen).length_squared() <= b.same_turn {
         solver.states[i].dr
     } else {
         b.q_seen = q;
@@ -420,5 +437,33 @@ mod tests {
         let solver = world.resource::<ContactSolver>();
         assert!(!solver.order.walk);
         assert_eq!(solver.states[0].v.x, 99.0);
+    }
+
+    /// A turn just within `same_turn(reach)` moves a point `reach` out from the centre by
+    /// at most `ANCHOR_LAG`, about any axis; twice that turn is past it. Past a reach of
+    /// 0.87 m the rounding floor (1e-12) sets the limit, as before the tolerance.
+    #[test]
+    fn a_reused_turn_lags_an_anchor_by_at_most_the_tolerance() {
+        for reach in [0.05f32, 0.5, 0.866] {
+            let limit = same_turn(reach);
+            assert!(limit > 1e-12);
+            for axis in [Vec3::X, Vec3::new(1.0, 2.0, -0.5).normalize()] {
+                // |q − 1|² = 4 sin²(θ/4), solved for the turn θ at the limit.
+                let theta = 4.0 * (0.5 * f64::from(limit).sqrt()).asin();
+                let q = glam::DQuat::from_axis_angle(axis.as_dvec3(), theta);
+                let distance = (q - glam::DQuat::IDENTITY).length_squared();
+                assert!((distance / f64::from(limit) - 1.0).abs() < 1e-6);
+                let p = axis.any_orthonormal_vector().as_dvec3() * f64::from(reach);
+                let moved = (q * p - p).length();
+                assert!(
+                    moved <= f64::from(ANCHOR_LAG) * 1.001,
+                    "{reach} m: {moved} m"
+                );
+                let q2 = glam::DQuat::from_axis_angle(axis.as_dvec3(), 2.0 * theta);
+                assert!((q2 * p - p).length() > f64::from(ANCHOR_LAG) * 1.9);
+            }
+        }
+        assert_eq!(same_turn(10.0), 1e-12);
+        assert_eq!(same_turn(0.0), 1e-12);
     }
 }

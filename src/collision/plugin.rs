@@ -148,7 +148,7 @@ pub(crate) fn shape_pose(x: Vec3A, q: Quat, com: Option<&CenterOfMass>) -> Pose 
 }
 
 /// Bounding radius of a shape about the centre of mass (m).
-fn radius(collider: &Collider, com: Option<&CenterOfMass>) -> f32 {
+pub(super) fn radius(collider: &Collider, com: Option<&CenterOfMass>) -> f32 {
     let [min, max] = collider.local_bounds();
     let c = com.map_or(Vec3::ZERO, |c| c.0);
     (min - c).length().max((max - c).length())

@@ -53,6 +53,8 @@ pub(super) struct Side {
     round: Roundness,
     /// How thin its shape is (m; see `ccd::thickness`).
     thin: f32,
+    /// Its bounding radius about the centre of mass (m).
+    reach: f32,
     friction: f32,
     restitution: f32,
     /// The collider's own restitution threshold (m/s), if it has one.
@@ -110,6 +112,7 @@ impl Side {
             entity,
             round: Roundness::of(collider.shape()),
             thin: super::ccd::thickness(collider.local_bounds()),
+            reach: super::plugin::radius(collider, com),
             index: Side::UNSET,
             x: x.0,
             q: q.0,
@@ -215,6 +218,7 @@ fn new_body(solver: &mut ContactSolver, side: &Side) -> u32 {
         x0: x,
         q0: q,
         q_seen: q,
+        same_turn: super::exchange::same_turn(side.reach),
         w_in: side.w,
         dynamic,
         isotropic: side.inertia.as_ref().is_some_and(Inertia::is_isotropic),

@@ -49,6 +49,9 @@ pub(crate) struct SolverBody {
     pub q0: Quat,
     /// The rotation at which the state's ΔR was last formed.
     pub q_seen: Quat,
+    /// How close (squared quaternion distance) a rotation must be to `q_seen` to reuse
+    /// that ΔR (see `exchange::same_turn`).
+    pub same_turn: f32,
     /// Angular velocity when the current pass began: the pass's change of ω, times the
     /// inertia, is the angular impulse it applied.
     pub w_in: Vec3A,
@@ -74,6 +77,7 @@ impl SolverBody {
             x0: Vec3A::ZERO,
             q0: Quat::IDENTITY,
             q_seen: Quat::IDENTITY,
+            same_turn: 1e-12,
             w_in: Vec3A::ZERO,
             dynamic: true,
             isotropic: false,
