@@ -36,6 +36,7 @@ impl Wanted {
     }
 
     /// The slot of `e`, which is added if new.
+    #[inline]
     pub fn slot(&mut self, e: Entity) -> usize {
         let entities = &self.entities;
         if let Some(i) = self.slots.find(e, |i| entities.get(i).copied()) {

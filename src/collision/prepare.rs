@@ -179,6 +179,7 @@ fn round_radius(shape: &dyn parry3d::shape::Shape) -> f32 {
 
 /// Solver index of a side's body, made on first use: a new [`SolverBody`] for anything
 /// with a velocity, [`FIXED`] for static colliders (whose velocities then read zero).
+#[inline]
 fn body_index(solver: &mut ContactSolver, side: &mut Side) -> u32 {
     if side.index == Side::UNSET {
         side.index = new_body(solver, side);
