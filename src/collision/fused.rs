@@ -204,34 +204,17 @@ fn load(
     found == solved
 }
 
-fn gather(solver: &mut ContactSolver, s: &mut Scratch) {
-    s.frozen.clear();
-    for (j, b) in s.hot[..solver.bodies.len()].iter().enumerate() {
-        // A quarantined body is no longer in the schedule's queries: its solver state stays
-        // as the last pass left it.
-        if b.live {
-            read_values(
-                solver,
-                j,
-                b.x,
-                b.q,
-                b.v,
-                Some(&b.l),
-                Some(&b.w),
-                &mut s.frozen,
-            );
-        }
-    }
-    for &i in &s.frozen {
-        solver.freeze(i);
-    }
+/// Loads solver body `j` into the solver's state (a quarantined body is no longer in the
+/// schedule's queries: its solver state stays as the last pass left it).
+#[inline(always)]
+fn read_body(solver: &mut ContactSolver, j: usize, b: &Hot, frozen: &mut Vec<u32>) {
+    read_values(solver, j, b.x, b.q, b.v, Some(&b.l), Some(&b.w), frozen);
 }
 
-fn scatter(solver: &ContactSolver, s: &mut Scratch) {
-    for (j, b) in s.hot[..solver.bodies.len()].iter_mut().enumerate() {
-        if b.live {
-            write_values(solver, j, &mut b.v, Some(&mut b.l));
-        }
+/// Takes the bodies that turned non-finite while loaded out of the rest of the step.
+fn freeze_all(solver: &mut ContactSolver, frozen: &[u32]) {
+    for &i in frozen {
+        solver.freeze(i);
     }
 }
 
@@ -369,26 +352,43 @@ fn step(
                 renormalize(b);
             }
         }
-        for b in in_solver.iter_mut().filter(|b| b.live) {
-            kick_body(b, h);
-        }
+        // Three sweeps over the solver bodies a substep, each doing for one body what the
+        // schedule does for all of them between two passes: the bodies' arrays are read
+        // once per pass, not once per stage.
         if solving {
-            gather(&mut solver, s);
-            biased_pass(&mut solver, &t, &settings);
-            scatter(&solver, s);
-        }
-        for (k, b) in s.hot[..solved].iter_mut().enumerate() {
-            if b.live {
-                drift_and_turn(b, k, h, limits, &guard, &mut trips);
+            s.frozen.clear();
+            for (j, b) in in_solver.iter_mut().enumerate() {
+                if b.live {
+                    kick_body(b, h);
+                    read_body(&mut solver, j, b, &mut s.frozen);
+                }
             }
-        }
-        if solving {
-            gather(&mut solver, s);
+            freeze_all(&mut solver, &s.frozen);
+            biased_pass(&mut solver, &t, &settings);
+            s.frozen.clear();
+            for (j, b) in in_solver.iter_mut().enumerate() {
+                if b.live {
+                    write_values(&solver, j, &mut b.v, Some(&mut b.l));
+                    drift_and_turn(b, j, h, limits, &guard, &mut trips);
+                    read_body(&mut solver, j, b, &mut s.frozen);
+                }
+            }
+            freeze_all(&mut solver, &s.frozen);
             relax_pass(&mut solver, &mut contacts, &t, &settings);
-            scatter(&solver, s);
-        }
-        for b in s.hot[..solved].iter_mut().filter(|b| b.live) {
-            renormalize(b);
+            for (j, b) in in_solver.iter_mut().enumerate() {
+                if b.live {
+                    write_values(&solver, j, &mut b.v, Some(&mut b.l));
+                    renormalize(b);
+                }
+            }
+        } else {
+            for (j, b) in in_solver.iter_mut().enumerate() {
+                if b.live {
+                    kick_body(b, h);
+                    drift_and_turn(b, j, h, limits, &guard, &mut trips);
+                    renormalize(b);
+                }
+            }
         }
         // The schedule quarantines after the substep: one system's bodies, then the other's,
         // each in query order.
