@@ -68,6 +68,7 @@ mod lanes;
 mod narrow;
 pub(crate) mod nodes;
 mod plugin;
+mod points;
 mod prepare;
 mod query;
 mod solver;

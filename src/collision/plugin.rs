@@ -8,7 +8,9 @@ use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 use super::broad::{BroadPhase, Entry};
 use super::exchange::{Live, SolvedBody, gather, scatter};
 use super::fetch::Wanted;
-use super::narrow::{ContactImpulse, Contacts, PairState, Recycle, choose_points};
+use super::narrow::{
+    ContactImpulse, Contacts, PairState, PointsKey, Recycle, choose_changed_points,
+};
 use super::solver::{ContactSolver, Softness};
 use super::{
     Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted, Sensor,
@@ -442,6 +444,7 @@ fn update_contacts(
                             state.workspace = None;
                         }
                         let reach = prediction + window;
+                        let before = PointsKey::of(&state.manifolds);
                         let result = guarded(&mut failed, || {
                             DefaultQueryDispatcher.contact_manifolds(
                                 &pos12,
@@ -458,9 +461,7 @@ fn update_contacts(
                         }
                         state.recycle =
                             (window > 0.0 && result.is_ok()).then_some(Recycle { pos12, reach });
-                        for m in &mut state.manifolds {
-                            choose_points(m, scratch);
-                        }
+                        choose_changed_points(&mut state.manifolds, before, scratch);
                     }
                 }
                 let thin = super::ccd::pair_thickness(ca.thin, cb.thin, settings.margin);
