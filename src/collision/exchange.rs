@@ -214,22 +214,25 @@ pub(super) fn read_values(
     // pass and the next substep's biased pass only renormalisation turns a body, by a
     // rounding; a body at rest turns by less than that lag for many substeps (in a 50-row
     // pyramid three reads in four formed ΔR again at a rounding's tolerance).
-    let dr = if (q - b.q_seen).length_squared() <= b.same_turn {
-        solver.states[i].dr
+    let dq = if (q - b.q_seen).length_squared() <= b.same_turn {
+        solver.states[i].dq
     } else {
         b.q_seen = q;
-        Mat3A::from_quat(q * b.q0.inverse())
+        q * b.q0.inverse()
     };
     let w = match l {
         Some(&l) if b.dynamic && b.isotropic => b.inv_i.x_axis.x * l,
-        Some(&l) if b.dynamic => dr * (b.inv_i * (dr.transpose() * l)),
+        Some(&l) if b.dynamic => {
+            let dr = Mat3A::from_quat(dq);
+            dr * (b.inv_i * (dr.transpose() * l))
+        }
         _ => w.copied().unwrap_or(Vec3A::ZERO),
     };
     let state = BodyState {
         v,
         w,
         dx: x - b.x0,
-        dr,
+        dq,
     };
     b.w_in = w;
     // One test of three lane masks, not three branches.

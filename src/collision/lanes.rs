@@ -4,7 +4,7 @@
 
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 
-use glam::{Mat3A, Vec3A};
+use glam::{Mat3A, Quat, Vec3A};
 use wide::f32x4;
 
 /// Four scalars, one per lane.
@@ -139,16 +139,35 @@ impl M3 {
     pub fn mul_vec(&self, v: V3) -> V3 {
         v.x * self.cols[0] + v.y * self.cols[1] + v.z * self.cols[2]
     }
+}
 
-    /// Mᵀ v, lane by lane.
+/// Four unit quaternions: vector part and scalar part.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Q4 {
+    pub v: V3,
+    pub w: F4,
+}
+
+impl Q4 {
+    /// Lane `i` holds `q[i]`.
     #[inline]
     #[must_use]
-    pub fn transpose_mul_vec(&self, v: V3) -> V3 {
-        V3 {
-            x: self.cols[0].dot(v),
-            y: self.cols[1].dot(v),
-            z: self.cols[2].dot(v),
+    pub fn from_lanes(q: [Quat; 4]) -> Self {
+        let [x, y, z, w] = F4::transpose(q.map(|q| F4::new(q.to_array())));
+        Self {
+            v: V3 { x, y, z },
+            w,
         }
+    }
+
+    /// Rᵀ v, lane by lane, for the rotation R of each (unit) quaternion: with t = 2 u × v,
+    /// Rᵀ v = v − w t + u × t (u the vector part; R v has + w t).
+    #[inline]
+    #[must_use]
+    pub fn inverse_rotate(&self, v: V3) -> V3 {
+        let u = self.v;
+        let t = F4::splat(2.0) * u.cross(v);
+        v - self.w * t + u.cross(t)
     }
 }
 
@@ -188,6 +207,30 @@ mod tests {
             assert_eq!(sums[i], a[i] + b[i]);
             let want = m[i] * a[i];
             assert!((want - mv[i]).length() < 1e-6, "lane {i}");
+        }
+    }
+
+    #[test]
+    fn a_quaternion_lane_turns_a_vector_back_as_the_transposed_matrix_does() {
+        let q = [
+            Quat::IDENTITY,
+            Quat::from_rotation_y(0.7),
+            Quat::from_axis_angle(glam::Vec3::new(1.0, -2.0, 0.5).normalize(), 2.9),
+            Quat::from_rotation_x(-1.3) * Quat::from_rotation_z(0.4),
+        ];
+        let v = [Vec3A::X, Vec3A::new(0.3, 0.7, -0.2), Vec3A::Y, Vec3A::ONE];
+        let turned = Q4::from_lanes(q).inverse_rotate(lanes_of(v)).lanes();
+        for i in 0..4 {
+            let want = Mat3A::from_quat(q[i]).transpose() * v[i];
+            assert!(
+                (want - turned[i]).length() < 1e-6,
+                "lane {i}: {want} {}",
+                turned[i]
+            );
+            // Not the forward turn (except for the identity).
+            if i > 0 {
+                assert!((Mat3A::from_quat(q[i]) * v[i] - turned[i]).length() > 1e-3);
+            }
         }
     }
 }
