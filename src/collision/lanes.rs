@@ -1,6 +1,6 @@
-//! Four contact manifolds at a time: 3-vectors and 3×3 matrices whose components are
-//! `f32x4` lanes (one lane per manifold). Every operation is the lane-wise IEEE operation of
-//! the scalar formula, so results are the same on every run.
+//! Four contact manifolds at a time: 3-vectors, 3×3 matrices and quaternions whose
+//! components are `f32x4` lanes (one lane per manifold). Every operation is the lane-wise
+//! IEEE operation of the scalar formula, so results are the same on every run.
 
 use std::ops::{Add, AddAssign, Mul, Neg, Sub, SubAssign};
 
