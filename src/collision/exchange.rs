@@ -31,17 +31,20 @@ const NONE: u32 = u32::MAX;
 /// resolution of a position 100 m from the origin.
 const ANCHOR_LAG: f32 = 1e-5;
 
+/// The smallest reuse limit (squared quaternion distance): a renormalisation's rounding.
+pub(super) const ROUNDING_TURN: f32 = 1e-12;
+
 /// The squared quaternion distance within which a body of bounding radius `reach` (m)
-/// reuses its ΔR: a turn by θ moves a point r out by θ r, and θ ≈ 2 |Δq|. At least a
-/// rounding (1e-12, the limit before the tolerance), which sets it past a reach of 0.87 m:
-/// there the lag is up to 2e-6 rad times the reach.
+/// reuses its ΔR: a turn by θ moves a point r out by θ r, and θ ≈ 2 |Δq|. At least
+/// [`ROUNDING_TURN`] (the limit before the tolerance), which sets it past a reach of
+/// 0.87 m: there the lag is up to 2e-6 rad times the reach.
 #[must_use]
 pub(super) fn same_turn(reach: f32) -> f32 {
     let d = ANCHOR_LAG / (2.0 * reach);
     if d.is_finite() {
-        (d * d).max(1e-12)
+        (d * d).max(ROUNDING_TURN)
     } else {
-        1e-12
+        ROUNDING_TURN
     }
 }
 
@@ -170,9 +173,7 @@ pub(super) fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live
             }
         }
     }
-    for i in frozen {
-        solver.freeze(i);
-    }
+    solver.freeze_all(&frozen);
 }
 
 #[inline(always)]
@@ -305,7 +306,7 @@ fn angular_impulse(b: &super::solver::SolverBody, state: &BodyState) -> Vec3A {
     }
 }
 
-/// [`write`] to plain values: v ← the solved v, L += I₀ Δω. Nothing for a body that is not
+/// [`write()`] to plain values: v ← the solved v, L += I₀ Δω. Nothing for a body that is not
 /// dynamic.
 #[inline(always)]
 pub(super) fn write_values(solver: &ContactSolver, i: usize, v: &mut Vec3A, l: Option<&mut Vec3A>) {

@@ -211,13 +211,6 @@ fn read_body(solver: &mut ContactSolver, j: usize, b: &Hot, frozen: &mut Vec<u32
     read_values(solver, j, b.x, b.q, b.v, Some(&b.l), Some(&b.w), frozen);
 }
 
-/// Takes the bodies that turned non-finite while loaded out of the rest of the step.
-fn freeze_all(solver: &mut ContactSolver, frozen: &[u32]) {
-    for &i in frozen {
-        solver.freeze(i);
-    }
-}
-
 /// A check that quarantined a body: in which of the two checks, the body's place in query
 /// order, its place in the arrays, why.
 type Trip = (u8, u32, usize, QuarantineReason);
@@ -343,12 +336,14 @@ fn step(
             reach_scale: guard.distance_scale(),
             spin: guard.max_angular_speed * guard.max_angular_speed,
         };
-        let (in_solver, free) = s.hot.split_at_mut(solved);
-        // Bodies outside the solver: the whole substep in one pass.
+        // Bodies outside the solver, and every body when nothing is solved: the whole
+        // substep in one pass.
+        let first_free = if solving { solved } else { 0 };
+        let (in_solver, free) = s.hot.split_at_mut(first_free);
         for (k, b) in free.iter_mut().enumerate() {
             if b.live {
                 kick_body(b, h);
-                drift_and_turn(b, solved + k, h, limits, &guard, &mut trips);
+                drift_and_turn(b, first_free + k, h, limits, &guard, &mut trips);
                 renormalize(b);
             }
         }
@@ -363,7 +358,7 @@ fn step(
                     read_body(&mut solver, j, b, &mut s.frozen);
                 }
             }
-            freeze_all(&mut solver, &s.frozen);
+            solver.freeze_all(&s.frozen);
             biased_pass(&mut solver, &t, &settings);
             s.frozen.clear();
             for (j, b) in in_solver.iter_mut().enumerate() {
@@ -373,19 +368,11 @@ fn step(
                     read_body(&mut solver, j, b, &mut s.frozen);
                 }
             }
-            freeze_all(&mut solver, &s.frozen);
+            solver.freeze_all(&s.frozen);
             relax_pass(&mut solver, &mut contacts, &t, &settings);
             for (j, b) in in_solver.iter_mut().enumerate() {
                 if b.live {
                     write_values(&solver, j, &mut b.v, Some(&mut b.l));
-                    renormalize(b);
-                }
-            }
-        } else {
-            for (j, b) in in_solver.iter_mut().enumerate() {
-                if b.live {
-                    kick_body(b, h);
-                    drift_and_turn(b, j, h, limits, &guard, &mut trips);
                     renormalize(b);
                 }
             }

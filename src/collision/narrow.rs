@@ -7,9 +7,7 @@ use glam::Vec3;
 use parry3d::math::Pose;
 use parry3d::query::{ContactManifold, ContactManifoldsWorkspace};
 
-pub(crate) use super::points::{
-    MAX_POINTS, PointsKey, choose_changed_points, choose_points, kept_normal_impulse,
-};
+use super::points::{MAX_POINTS, kept_normal_impulse};
 
 /// What each contact point carries from step to step: its accumulated normal impulse, for
 /// warm starting. parry moves it to the matching point of the next step's manifold.
@@ -21,7 +19,7 @@ pub(crate) struct ContactImpulse {
 
 /// What a manifold carries from step to step: its friction impulses, for warm starting, and
 /// which of its points the solver takes (chosen when its points are found, see
-/// [`choose_points`]).
+/// [`choose_points`](super::points::choose_points)).
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct ManifoldData {
     /// Friction impulse at the manifold's centre (N·s, world frame).

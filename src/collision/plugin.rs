@@ -8,9 +8,8 @@ use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 use super::broad::{BroadPhase, Entry};
 use super::exchange::{Live, SolvedBody, gather, scatter};
 use super::fetch::Wanted;
-use super::narrow::{
-    ContactImpulse, Contacts, PairState, PointsKey, Recycle, choose_changed_points,
-};
+use super::narrow::{ContactImpulse, Contacts, PairState, Recycle};
+use super::points::{PointsKey, choose_changed_points};
 use super::solver::{ContactSolver, Softness};
 use super::{
     Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted, Sensor,

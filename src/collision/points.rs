@@ -89,10 +89,12 @@ pub(crate) fn choose_changed_points(
 /// defaults, and with every box moved up to 0.1 mm sideways none of 8 stood. Started from
 /// the same direction, every joint tilts alike, the column leans a little as a whole and
 /// stands (8 of 8 with those offsets, each top 0.16 m off the axis; 5 of 8 columns of 150;
-/// with [`FrozenGeometry::COMPRESSION_TOLERANCE`]). Sorted along one axis and then the other
-/// instead (as rapier 0.36 does), the corners were no longer taken around the face: a
-/// cube landing flat slid and tipped, and the symmetric relax sweep (see the solver) lost
-/// its point.
+/// with the compression tolerance of [`FrozenGeometry`]). Sorted along one axis and then
+/// the other instead (as rapier 0.36 does), the corners were no longer taken around the
+/// face: a cube landing flat slid and tipped, and the symmetric relax sweep (see the
+/// solver) lost its point.
+///
+/// [`FrozenGeometry`]: super::narrow::FrozenGeometry
 fn solve_order(keep: &mut [usize], m: &Manifold) {
     if keep.len() < 2 {
         return;

@@ -8,8 +8,9 @@ use parry3d::math::Pose;
 use super::broad::BroadPhase;
 use super::exchange::Live;
 use super::fetch::Wanted;
-use super::narrow::{Contacts, FrozenGeometry, MAX_POINTS};
+use super::narrow::{Contacts, FrozenGeometry};
 use super::plugin::{part_pose, shape_pose};
+use super::points::MAX_POINTS;
 use super::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, SolverBody};
 use super::{Collider, ContactSettings, Friction, Restitution, RestitutionThreshold};
 use crate::integrator::ConstraintsActive;
@@ -248,7 +249,7 @@ fn tangent_basis(
 ) -> [Vec3A; 2] {
     let slide = (vb + wb.cross(centre - xb)) - (va + wa.cross(centre - xa));
     let impulse = Vec3A::from(m.data.tangent);
-    let normal = super::narrow::kept_normal_impulse(m);
+    let normal = super::points::kept_normal_impulse(m);
     let along = |v: Vec3A| (v - n * n.dot(v)).try_normalize();
     // Only a clear signal picks the direction: below it (a body at rest under a small
     // sideways load) a noisy direction would turn the basis from step to step, and a fixed

@@ -77,7 +77,7 @@ impl SolverBody {
             x0: Vec3A::ZERO,
             q0: Quat::IDENTITY,
             q_seen: Quat::IDENTITY,
-            same_turn: 1e-12,
+            same_turn: super::exchange::ROUNDING_TURN,
             w_in: Vec3A::ZERO,
             dynamic: true,
             isotropic: false,
@@ -98,6 +98,8 @@ pub(crate) struct BodyState {
     pub dx: Vec3A,
     pub dq: Quat,
 }
+
+const _: () = assert!(size_of::<BodyState>() == 64);
 
 impl BodyState {
     /// A body that does not move: every static collider reads this.
@@ -671,6 +673,13 @@ impl ContactSolver {
         (batch.inv_m_a, batch.inv_m_b) = (ma, mb);
     }
 
+    /// [`Self::freeze`] for each of `bodies` (those a gather found non-finite).
+    pub fn freeze_all(&mut self, bodies: &[u32]) {
+        for &body in bodies {
+            self.freeze(body);
+        }
+    }
+
     /// Takes `body` out of the rest of the step: it turned non-finite, and from now on every
     /// contact sees it as an immovable, motionless obstacle.
     pub fn freeze(&mut self, body: u32) {
@@ -897,7 +906,7 @@ impl ContactSolver {
                 (0..4).filter_map(move |l| {
                     let m = self.manifolds.get(batch.lanes[l] as usize)?;
                     let inputs = &self.inputs[m.first as usize..(m.first + m.count) as usize];
-                    let mut normals = [(0, 0.0); super::narrow::MAX_POINTS];
+                    let mut normals = [(0, 0.0); super::points::MAX_POINTS];
                     for ((slot, p), input) in normals.iter_mut().zip(points).zip(inputs) {
                         *slot = (input.source, p.n_imp.to_array()[l]);
                     }
@@ -918,7 +927,7 @@ impl ContactSolver {
 pub(crate) struct SolvedManifold<'a> {
     pub constraint: &'a ManifoldConstraint,
     /// (point index in the narrow phase's manifold, normal impulse); the first `count`.
-    pub normals: [(u32, f32); super::narrow::MAX_POINTS],
+    pub normals: [(u32, f32); super::points::MAX_POINTS],
     pub count: usize,
     pub tangent: Vec3A,
     pub twist: f32,
