@@ -1,7 +1,7 @@
 //! The long fuzz run: `cargo run --release --example fuzz -- --cases 20000 --seed 1` (worlds; ten
 //! times as many constructor cases). Prints the table in the README.
 
-#[path = "../tests/fuzz/harness.rs"]
+#[path = "../tests/it/robustness/harness.rs"]
 mod harness;
 
 fn main() {
@@ -32,5 +32,8 @@ fn main() {
         "| worlds ({} steps) | {} | – | – | {} | {} | {} | {} |",
         w.steps, w.inputs, w.panics, w.quarantines, w.silent, w.snapshot_mismatches
     );
+    for failure in [&c.failure, &w.failure].into_iter().flatten() {
+        println!("\nfailed: {failure}");
+    }
     println!("\n{:.0} s", start.elapsed().as_secs_f64());
 }

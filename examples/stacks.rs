@@ -109,7 +109,7 @@ fn main() {
         hertz: 7.5 * substeps as f32,
     };
     // Each case: name, boxes, densities, the soft contacts' own sink at the defaults (30 Hz
-    // between bodies, 60 Hz against the ground; see `tests/issue_tall_stacks.rs`), and the
+    // between bodies, 60 Hz against the ground; see `tests/it/collision/tall_stacks.rs`), and the
     // stiffer settings to try as well.
     let mut cases: Vec<Case> = Vec::new();
     for n in [10, 20, 30, 50, 100, 200] {

@@ -449,7 +449,7 @@ pub fn column_spec(n: usize) -> Vec<BoxSpec> {
 
 /// [`column_spec`] with every box moved sideways (x and z) by up to `offset` m, seeded by
 /// `run`: the same run gives the same column. One straight column standing can be luck;
-/// these ask how often (`examples/column_trials.rs`, `tests/issue_tall_stacks.rs`).
+/// these ask how often (`examples/column_trials.rs`, `tests/it/collision/tall_stacks.rs`).
 #[must_use]
 pub fn perturbed_column_spec(n: usize, offset: f32, run: usize) -> Vec<BoxSpec> {
     let mut specs = column_spec(n);

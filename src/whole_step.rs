@@ -8,7 +8,7 @@
 //! outside the solver itself. The collision plugin therefore registers a
 //! [`WholeStepRunner`]: a function that loads the bodies once, runs every substep with the
 //! very same arithmetic in the same order, and stores them once. Results are bit-identical
-//! with the schedule's (`tests/whole_step.rs` compares the two paths after every step, and
+//! with the schedule's (`tests/it/integrators/whole_step.rs` compares the two paths after every step, and
 //! lists every substep system with how this path treats it).
 //!
 //! The runner is tried only when the schedule would do nothing it does not replicate:

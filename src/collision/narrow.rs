@@ -43,7 +43,7 @@ pub(crate) struct ManifoldData {
 /// of 20 unit boxes fell over in 5 s and the 50-row one-deep pyramid leaned out of its plane
 /// and fell by 15 s. With the arms fixed, the separation is still measured at the turned
 /// points (only the directions the impulses act along are held), and both stand (see
-/// `tests/issue_tall_stacks.rs`). Each arm rides with its body's centre of mass.
+/// `tests/it/collision/tall_stacks.rs`). Each arm rides with its body's centre of mass.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
 pub(crate) struct FrozenGeometry {
     /// Normal from the first shape to the second (world frame).

@@ -1,0 +1,5 @@
+//! The Bevy layer: App clock, Transform sync, spawning by required components, prelude imports.
+
+mod app;
+mod preludes;
+mod required_components_spawning;

@@ -1,0 +1,3 @@
+//! Cloth: builders, wind, strain limiting, collisions and the implicit path.
+
+mod cloth;

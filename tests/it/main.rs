@@ -1,0 +1,17 @@
+//! hooke's integration tests: one binary, a module per subject.
+
+mod bevy;
+mod cloth;
+mod collision;
+mod common;
+mod docs;
+mod integrators;
+mod particles;
+mod rigid;
+mod robustness;
+mod scenario;
+mod schedule;
+mod sleep;
+mod snapshot;
+mod soft;
+mod springs;

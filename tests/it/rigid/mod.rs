@@ -1,0 +1,5 @@
+//! Rigid bodies: torque-free motion, mass properties from shapes, and a cross-check with rapier.
+
+mod mass;
+mod rapier_crosscheck;
+mod rigid;

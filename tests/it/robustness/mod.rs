@@ -1,0 +1,8 @@
+//! Bad input and fuzzing: typed errors, quarantine, never a panic.
+
+mod bad_input;
+mod bad_input_caught;
+mod fuzz;
+mod fuzz_findings;
+mod harness;
+mod runaway_velocity_quarantined_first;

@@ -1,0 +1,8 @@
+//! Tetrahedral soft bodies: strain models, meshes, implicit solves, attachments and contact.
+
+mod attach;
+mod contact_two_way;
+mod implicit;
+mod mesh_files;
+mod soft_body;
+mod strain;

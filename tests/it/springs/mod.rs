@@ -1,0 +1,8 @@
+//! Springs, chains and spring meshes: forces, stability limits, warnings and the implicit solves.
+
+mod chain;
+mod default_builders_stable;
+mod implicit_entities;
+mod implicit_meshes;
+mod springs;
+mod stiff_springs_warned_and_caught;
