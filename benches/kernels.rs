@@ -154,7 +154,7 @@ fn main() {
 /// Rotation kernels, each against a trivial quaternion product over the same data.
 pub fn rotation_kernels(cfg: &Config) {
     use glam::Quat;
-    use hooke::Inertia;
+    use hooke::rigid::Inertia;
     use hooke::rigid::{OrientationUpdate, free_rotation_split, integrate_rotation};
     let n = 100_000;
     let inertia = Inertia::diagonal(1.0, 2.0, 3.0).unwrap();

@@ -15,8 +15,13 @@ use std::time::Instant;
 
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
+use hooke::cloth::Cloth;
+use hooke::cloth::ClothBuilder;
+use hooke::cloth::ClothMaterial;
+use hooke::integrator::ImplicitEuler;
+use hooke::particles::VelocityField;
 use hooke::prelude::*;
-use hooke::{Cloth, ClothBuilder, ClothMaterial, ImplicitEuler, VelocityField, scenes};
+use hooke::scenes;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 
@@ -72,7 +77,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let flag = flag(&mut windy)?;
 
     let mut drape = scenes::world_with(1.0 / 60.0, 1, Integrator::SymplecticEuler, g)?;
-    drape.resource_mut::<hooke::SleepSettings>().enabled = false;
+    drape.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     let radius = 0.5;
     drape.spawn((
         RigidBodyBundle::fixed(Vec3::new(0.0, radius, 0.0), Quat::IDENTITY)?,

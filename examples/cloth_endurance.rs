@@ -12,8 +12,11 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::cloth::ClothBuilder;
+use hooke::core::quarantine::Quarantined;
+use hooke::integrator::ImplicitEuler;
+use hooke::integrator::ImplicitState;
 use hooke::prelude::*;
-use hooke::{ClothBuilder, ImplicitEuler, ImplicitState, Quarantined};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -34,7 +37,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Integrator::SymplecticEuler,
         Vec3::new(0.0, -9.81, 0.0),
     )?;
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     let (nodes, net) = ClothBuilder::new(Vec3::new(0.0, 2.0, 0.0), 64, 64, 0.03)
         .stiffness(5e3, 1e3, 1e2)
         .build()?;

@@ -18,7 +18,7 @@ mod rapier_boxes;
 fn hooke_stray(specs: &[BoxSpec], steps: usize) -> f32 {
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     let boxes = scenes::spawn_boxes(&mut w, specs).expect("valid boxes");
     let top = *boxes.last().expect("at least one box");
     let mut worst = 0.0f32;

@@ -15,9 +15,11 @@ use std::time::Instant;
 
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
+use hooke::core::quarantine::Quarantined;
+use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
+use hooke::scenes;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
-use hooke::{ImplicitEuler, Quarantined, scenes};
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 

@@ -9,8 +9,10 @@ mod common;
 
 use bevy_ecs::prelude::*;
 use common::register_fonts;
+use hooke::collision::Contacts;
 use hooke::prelude::*;
-use hooke::{Contacts, Rotation, scenes};
+use hooke::rigid::Rotation;
+use hooke::scenes;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -146,7 +148,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         frame(&gif, &world, &boxes, &balls, t)?;
         if step % 60 == 0 {
             let asleep = world
-                .query_filtered::<(), With<hooke::Sleeping>>()
+                .query_filtered::<(), With<hooke::core::rest::Sleeping>>()
                 .iter(&world)
                 .count();
             let d = world.resource::<PhysicsDiagnostics>();

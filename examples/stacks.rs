@@ -51,9 +51,9 @@ impl Outcome {
 fn ours(specs: &[BoxSpec], densities: &[f32], s: Stiffness) -> Outcome {
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
-    w.insert_resource(hooke::PhysicsTime::new(1.0 / 60.0, s.substeps).unwrap());
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
-    w.resource_mut::<hooke::ContactSettings>().hertz = s.hertz;
+    w.insert_resource(hooke::core::time::PhysicsTime::new(1.0 / 60.0, s.substeps).unwrap());
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::collision::ContactSettings>().hertz = s.hertz;
     let boxes = scenes::spawn_boxes_with_density(&mut w, specs, |i| densities[i]).unwrap();
     let top = top_of(specs);
     let start = specs.iter().filter(|b| !b.fixed).nth(top).unwrap().position;

@@ -11,9 +11,13 @@ mod common;
 
 use common::register_fonts;
 use hooke::prelude::*;
-use hooke::{
-    AngularMomentum, AngularVelocity, Inertia, MassProperties, RigidBodyBundle, Rotation, scenes,
-};
+use hooke::rigid::AngularMomentum;
+use hooke::rigid::AngularVelocity;
+use hooke::rigid::Inertia;
+use hooke::rigid::MassProperties;
+use hooke::rigid::RigidBodyBundle;
+use hooke::rigid::Rotation;
+use hooke::scenes;
 use plotters::prelude::*;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

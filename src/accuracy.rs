@@ -55,8 +55,12 @@ use std::time::{Duration, Instant};
 
 use bevy_ecs::prelude::*;
 
-use crate::error::{Error, Result};
-use crate::{Integrator, PhysicsDiagnostics, PhysicsPlugins, PhysicsTime, PhysicsWorldExt};
+use crate::PhysicsPlugins;
+use crate::PhysicsWorldExt;
+use crate::core::diagnostics::PhysicsDiagnostics;
+use crate::core::error::{Error, Result};
+use crate::core::time::PhysicsTime;
+use crate::integrator::Integrator;
 
 /// One point on the dial: an integrator and the substeps per fixed step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -149,262 +149,84 @@ pub mod accuracy;
 pub mod bevy;
 pub mod cloth;
 pub mod collision;
-pub mod diagnostics;
-pub mod error;
+pub mod core;
 pub mod integrator;
-mod order;
 pub mod particles;
-pub mod quarantine;
-pub mod rest;
-pub mod restore;
+mod plugins;
 pub mod rigid;
 pub mod scenario;
 pub mod scenes;
-pub mod schedule;
 pub mod sleep;
 pub mod snapshot;
 pub mod soft;
 pub mod springs;
 pub mod testing;
-pub mod time;
-pub mod whole_step;
 
 /// parry, re-exported so custom shapes ([`Collider::new`]) need no second dependency.
 pub use parry3d;
 
-use bevy_ecs::message::Messages;
-use bevy_ecs::prelude::*;
-
-pub use cloth::{Cloth, ClothBuilder, ClothMaterial, ClothPlugin};
-pub use collision::{
-    Collider, ColliderChanges, ColliderDensity, ColliderOf, ColliderOffset, CollisionEventsEnabled,
-    CollisionLayers, CollisionPlugin, CombineRule, ContactEnd, ContactEnded, ContactSettings,
-    ContactStart, ContactStarted, Contacts, Friction, Restitution, RestitutionThreshold, Sensor,
-    SpatialQuery,
-};
-pub use diagnostics::{DiagnosticsSettings, PhysicsDiagnostics};
-pub use error::{Error, Result};
-pub use integrator::{
-    ConstraintsActive, ImplicitEuler, ImplicitState, Integrator, IntegratorOverride,
-    IntegratorPlugin,
-};
-pub use particles::{
-    Advection, DampingPlugin, ExternalForce, ExternalImpulse, Force, Gravity, GravityPlugin,
-    GravityScale, LinearDamping, LinearVelocity, Mass, Nodes, ParticleBundle, Position, Tracer,
-    VelocityField, VelocityFieldPlugin,
-};
-pub use quarantine::{BodyQuarantined, DivergenceGuard, QuarantineReason, Quarantined};
-pub use rigid::{
-    AngularDamping, AngularMomentum, AngularVelocity, CenterOfMass, ExternalForceAtPoint,
-    ExternalImpulseAtPoint, ExternalTorque, Inertia, KinematicTarget, MassProperties,
-    OrientationUpdate, Renormalization, RigidBody, RigidBodyBundle, RigidBodyPlugin, Rotation,
-    SkipRenormalization, Torque,
-};
-pub use schedule::{
-    ForceSchedule, ForceSystems, ImplicitSystems, PhysicsSchedule, PhysicsSystems, RelaxSystems,
-    StepSystems, SubstepSchedule,
-};
-pub use sleep::{SleepPlugin, SleepSettings, Sleeping, SleepingDisabled};
-pub use springs::{
-    Chain, ChainBuilder, EntitySpringStability, Spring, SpringNetwork, SpringPlugin, SpringReading,
-    SpringStability, StabilityPolicy, StabilityWarning,
-};
-pub use time::{FrameReport, PhysicsTime, SubstepTime};
-pub use whole_step::FusedSubsteps;
+pub use core::error::{Error, Result};
+pub use plugins::{PhysicsPlugins, PhysicsWorldExt};
 
 /// Everything a game needs in scope.
 pub mod prelude {
+    pub use crate::Error;
+    pub use crate::PhysicsPlugins;
+    pub use crate::PhysicsWorldExt;
     #[cfg(feature = "bevy")]
     pub use crate::bevy::{
         PhysicsAppSystems, PhysicsDiagnosticsPlugin, PhysicsSchedulePlugin, TransformExtrapolation,
         TransformInterpolation,
     };
-    pub use crate::{
-        Advection, BodyQuarantined, ChainBuilder, ClothBuilder, DiagnosticsSettings, Error,
-        ExternalForce, ExternalImpulse, Force, Gravity, GravityScale, Integrator,
-        IntegratorOverride, LinearDamping, LinearVelocity, Mass, Nodes, ParticleBundle,
-        PhysicsDiagnostics, PhysicsPlugins, PhysicsTime, PhysicsWorldExt, Position,
-        QuarantineReason, Quarantined, Spring, SpringNetwork, Tracer, VelocityField, WorldPlugin,
-    };
-    pub use crate::{
-        AngularVelocity, CenterOfMass, Collider, ColliderDensity, ColliderOf, ColliderOffset,
-        CollisionEventsEnabled, ContactEnd, ContactStart, Contacts, Friction, Inertia,
-        MassProperties, Restitution, RigidBody, RigidBodyBundle, Rotation, Sensor, Sleeping,
-        SpatialQuery,
-    };
-    pub use crate::{CollisionLayers, ContactEnded, ContactStarted};
+    pub use crate::cloth::ClothBuilder;
+    pub use crate::collision::Collider;
+    pub use crate::collision::ColliderDensity;
+    pub use crate::collision::ColliderOf;
+    pub use crate::collision::ColliderOffset;
+    pub use crate::collision::CollisionEventsEnabled;
+    pub use crate::collision::CollisionLayers;
+    pub use crate::collision::ContactEnd;
+    pub use crate::collision::ContactEnded;
+    pub use crate::collision::ContactStart;
+    pub use crate::collision::ContactStarted;
+    pub use crate::collision::Contacts;
+    pub use crate::collision::Friction;
+    pub use crate::collision::Restitution;
+    pub use crate::collision::Sensor;
+    pub use crate::collision::SpatialQuery;
+    pub use crate::core::diagnostics::DiagnosticsSettings;
+    pub use crate::core::diagnostics::PhysicsDiagnostics;
+    pub use crate::core::plugin::WorldPlugin;
+    pub use crate::core::quarantine::BodyQuarantined;
+    pub use crate::core::quarantine::QuarantineReason;
+    pub use crate::core::quarantine::Quarantined;
+    pub use crate::core::rest::Sleeping;
+    pub use crate::core::time::PhysicsTime;
+    pub use crate::integrator::Integrator;
+    pub use crate::integrator::IntegratorOverride;
+    pub use crate::particles::Advection;
+    pub use crate::particles::ExternalForce;
+    pub use crate::particles::ExternalImpulse;
+    pub use crate::particles::Force;
+    pub use crate::particles::Gravity;
+    pub use crate::particles::GravityScale;
+    pub use crate::particles::LinearDamping;
+    pub use crate::particles::LinearVelocity;
+    pub use crate::particles::Mass;
+    pub use crate::particles::Nodes;
+    pub use crate::particles::ParticleBundle;
+    pub use crate::particles::Position;
+    pub use crate::particles::Tracer;
+    pub use crate::particles::VelocityField;
+    pub use crate::rigid::AngularVelocity;
+    pub use crate::rigid::CenterOfMass;
+    pub use crate::rigid::Inertia;
+    pub use crate::rigid::MassProperties;
+    pub use crate::rigid::RigidBody;
+    pub use crate::rigid::RigidBodyBundle;
+    pub use crate::rigid::Rotation;
+    pub use crate::springs::ChainBuilder;
+    pub use crate::springs::Spring;
+    pub use crate::springs::SpringNetwork;
     pub use glam::{Quat, Vec3, Vec3A};
-}
-
-/// A piece of physics that installs itself into a `World`: resources and systems.
-pub trait WorldPlugin: 'static {
-    /// Adds the plugin's resources and systems. Called once per world.
-    fn build(&self, world: &mut World);
-}
-
-/// Anything the substeps could move.
-type AnyBody = Or<(With<Mass>, With<Nodes>, With<Tracer>)>;
-
-/// Names of the plugins already built into a world, so adding one twice is harmless.
-#[derive(Resource, Default)]
-struct InstalledPlugins(Vec<core::any::TypeId>);
-
-/// Schedules, time, integrators, external forces, quarantine and diagnostics. Added
-/// automatically before any other plugin.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct PhysicsCorePlugin;
-
-impl WorldPlugin for PhysicsCorePlugin {
-    fn build(&self, world: &mut World) {
-        schedule::init_schedules(world);
-        if !world.contains_resource::<PhysicsTime>() {
-            world.insert_resource(PhysicsTime::default());
-        }
-        restore::init::<PhysicsTime>(world);
-        restore::init::<Messages<restore::ResourceRestored>>(world);
-        restore::init::<Messages<restore::InvalidSetting>>(world);
-        schedule::add_own_systems(
-            world,
-            PhysicsSchedule,
-            restore::restore_resources.in_set(PhysicsSystems::Restore),
-        );
-        schedule::add_own_systems(
-            world,
-            PhysicsSchedule,
-            quarantine::quarantine_runaway_velocities.in_set(schedule::PrepareSystems::Guard),
-        );
-        crate::restore::init::<SubstepTime>(world);
-        crate::restore::init::<FusedSubsteps>(world);
-        crate::restore::init::<Messages<BodyQuarantined>>(world);
-        crate::restore::init::<quarantine::DivergenceGuard>(world);
-        schedule::add_own_systems(
-            world,
-            PhysicsSchedule,
-            time::run_substeps::<AnyBody>.in_set(PhysicsSystems::Step),
-        );
-        diagnostics::install(world);
-        world.add_physics(IntegratorPlugin);
-    }
-}
-
-/// Every effect: core, gravity, damping, velocity fields, springs, rigid bodies and
-/// collisions.
-#[derive(Debug, Default, Clone, Copy)]
-pub struct PhysicsPlugins;
-
-impl WorldPlugin for PhysicsPlugins {
-    fn build(&self, world: &mut World) {
-        world
-            .add_physics(GravityPlugin)
-            .add_physics(DampingPlugin)
-            .add_physics(VelocityFieldPlugin)
-            .add_physics(SpringPlugin)
-            .add_physics(RigidBodyPlugin)
-            .add_physics(CollisionPlugin)
-            .add_physics(SleepPlugin)
-            .add_physics(soft::SoftBodyPlugin)
-            .add_physics(cloth::ClothPlugin);
-    }
-}
-
-/// Physics on a bare `World`.
-pub trait PhysicsWorldExt {
-    /// Builds `plugin` into this world (once; later calls with the same plugin do nothing).
-    /// The core plugin is added first if missing.
-    fn add_physics<P: WorldPlugin>(&mut self, plugin: P) -> &mut Self;
-
-    /// Runs one fixed step of [`PhysicsTime::dt`]. Does nothing without the core plugin.
-    fn step_physics(&mut self);
-
-    /// Adds `frame_dt` seconds of frame time and runs the whole steps that fit, up to
-    /// [`PhysicsTime::max_steps_per_frame`].
-    ///
-    /// # Errors
-    /// [`Error::InvalidTimeStep`] for a negative or non-finite `frame_dt` (nothing runs).
-    fn advance_physics(&mut self, frame_dt: f32) -> Result<FrameReport>;
-}
-
-fn mark_installed<P: WorldPlugin>(world: &mut World) -> bool {
-    let id = core::any::TypeId::of::<P>();
-    let mut installed = world.get_resource_or_init::<InstalledPlugins>();
-    if installed.0.contains(&id) {
-        false
-    } else {
-        installed.0.push(id);
-        true
-    }
-}
-
-/// Messages live for two rotations; see [`BodyQuarantined`].
-fn rotate_messages(world: &mut World) {
-    if let Some(mut m) = world.get_resource_mut::<Messages<BodyQuarantined>>() {
-        m.update();
-    }
-    if let Some(mut m) = world.get_resource_mut::<Messages<ContactStarted>>() {
-        m.update();
-    }
-    if let Some(mut m) = world.get_resource_mut::<Messages<ContactEnded>>() {
-        m.update();
-    }
-    if let Some(mut m) = world.get_resource_mut::<Messages<springs::StabilityWarning>>() {
-        m.update();
-    }
-    if let Some(mut m) = world.get_resource_mut::<Messages<restore::ResourceRestored>>() {
-        m.update();
-    }
-    if let Some(mut m) = world.get_resource_mut::<Messages<restore::InvalidSetting>>() {
-        m.update();
-    }
-}
-
-pub(crate) fn run_step(world: &mut World) {
-    let start = std::time::Instant::now();
-    let _ = world.try_run_schedule(PhysicsSchedule);
-    if let Some(mut d) = world.get_resource_mut::<PhysicsDiagnostics>() {
-        d.step_time = start.elapsed();
-    }
-}
-
-impl PhysicsWorldExt for World {
-    fn add_physics<P: WorldPlugin>(&mut self, plugin: P) -> &mut Self {
-        if mark_installed::<PhysicsCorePlugin>(self) {
-            PhysicsCorePlugin.build(self);
-        }
-        if mark_installed::<P>(self) {
-            plugin.build(self);
-        }
-        self
-    }
-
-    fn step_physics(&mut self) {
-        if !self.contains_resource::<PhysicsTime>() {
-            // The clock itself was removed (the step's own restore pass would not run):
-            // put everything back first; without the core plugin this does nothing.
-            restore::restore_resources(self);
-            if !self.contains_resource::<PhysicsTime>() {
-                return;
-            }
-        }
-        rotate_messages(self);
-        run_step(self);
-    }
-
-    fn advance_physics(&mut self, frame_dt: f32) -> Result<FrameReport> {
-        if !self.contains_resource::<PhysicsTime>() {
-            restore::restore_resources(self);
-        }
-        let Some(mut time) = self.get_resource_mut::<PhysicsTime>() else {
-            return Ok(FrameReport::default());
-        };
-        let (steps, dropped) = time.take_frame(frame_dt)?;
-        // Rotate once per frame, so a game reading messages every frame sees every step's.
-        rotate_messages(self);
-        for _ in 0..steps {
-            run_step(self);
-        }
-        if let Some(mut d) = self.get_resource_mut::<PhysicsDiagnostics>() {
-            d.dropped_time = dropped;
-        }
-        Ok(FrameReport { steps, dropped })
-    }
 }

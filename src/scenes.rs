@@ -4,11 +4,14 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
+use crate::PhysicsPlugins;
+use crate::PhysicsWorldExt;
 use crate::cloth::ClothBuilder;
-use crate::error::Result;
+use crate::core::error::Result;
+use crate::core::time::PhysicsTime;
+use crate::integrator::Integrator;
 use crate::particles::{Gravity, ParticleBundle, Tracer, VelocityField};
 use crate::springs::{Chain, ChainBuilder, Spring};
-use crate::{Integrator, PhysicsPlugins, PhysicsTime, PhysicsWorldExt};
 
 /// A world with every plugin, the given step and integrator, and gravity `g`.
 ///
@@ -114,7 +117,9 @@ pub fn showcase(world: &mut World) -> Result<Showcase> {
             let r = 0.2 + 0.05 * i as f32;
             let a = i as f32 * 0.7;
             let x = Vec3::new(3.5 + r * a.cos(), 1.5 + r * a.sin(), 0.0);
-            Ok(world.spawn((crate::Position::try_new(x)?, Tracer)).id())
+            Ok(world
+                .spawn((crate::particles::Position::try_new(x)?, Tracer))
+                .id())
         })
         .collect::<Result<Vec<_>>>()?;
     let particles = (0..8)
@@ -153,12 +158,12 @@ pub fn tumbling_box_start(i: usize, n: usize) -> (Vec3, Vec3) {
 pub fn tumbling_boxes(world: &mut World, n: usize) -> Result<()> {
     let (half, density) = TUMBLING_BOX;
     let shape = parry3d::shape::Cuboid::new(half);
-    let props = crate::MassProperties::from_shape(&shape, density)?;
+    let props = crate::rigid::MassProperties::from_shape(&shape, density)?;
     let mut batch = Vec::with_capacity(n);
     for i in 0..n {
         let (x, omega) = tumbling_box_start(i, n);
         batch.push(
-            crate::RigidBodyBundle::dynamic(props)?
+            crate::rigid::RigidBodyBundle::dynamic(props)?
                 .at(x)?
                 .with_angular_velocity(omega)?,
         );
@@ -179,7 +184,7 @@ pub fn ground(world: &mut World) -> Result<Entity> {
 /// body of `density` (kg/m³). Every scene's bodies come through here.
 fn spawn_body(
     world: &mut World,
-    collider: crate::Collider,
+    collider: crate::collision::Collider,
     position: Vec3,
     rotation: glam::Quat,
     fixed: bool,
@@ -187,18 +192,21 @@ fn spawn_body(
 ) -> Result<Entity> {
     if fixed {
         return Ok(world
-            .spawn((crate::RigidBodyBundle::fixed(position, rotation)?, collider))
+            .spawn((
+                crate::rigid::RigidBodyBundle::fixed(position, rotation)?,
+                collider,
+            ))
             .id());
     }
-    let props = crate::MassProperties::from_shape(&**collider.shape(), density)?;
-    let body = crate::RigidBodyBundle::dynamic(props)?
+    let props = crate::rigid::MassProperties::from_shape(&**collider.shape(), density)?;
+    let body = crate::rigid::RigidBodyBundle::dynamic(props)?
         .at(position)?
         .with_rotation(rotation)?;
     Ok(world.spawn((body, collider)).id())
 }
 
 fn spawn_box(world: &mut World, b: &BoxSpec, density: f32) -> Result<Entity> {
-    let collider = crate::Collider::cuboid(b.half.x, b.half.y, b.half.z)?;
+    let collider = crate::collision::Collider::cuboid(b.half.x, b.half.y, b.half.z)?;
     spawn_body(world, collider, b.position, b.rotation, b.fixed, density)
 }
 
@@ -217,7 +225,7 @@ pub fn dynamic_box(world: &mut World, half: Vec3, x: Vec3) -> Result<Entity> {
 pub fn dynamic_ball(world: &mut World, r: f32, x: Vec3) -> Result<Entity> {
     spawn_body(
         world,
-        crate::Collider::ball(r)?,
+        crate::collision::Collider::ball(r)?,
         x,
         glam::Quat::IDENTITY,
         false,
@@ -414,8 +422,8 @@ pub fn pile_scene(
     ground(world)?;
     let q = glam::Quat::from_rotation_z(20f32.to_radians());
     world.spawn((
-        crate::RigidBodyBundle::fixed(Vec3::new(-3.0, 1.5, 0.0), q)?,
-        crate::Collider::cuboid(4.0, 0.2, 2.0)?,
+        crate::rigid::RigidBodyBundle::fixed(Vec3::new(-3.0, 1.5, 0.0), q)?,
+        crate::collision::Collider::cuboid(4.0, 0.2, 2.0)?,
     ));
     let mut out = (Vec::new(), Vec::new());
     for i in 0..boxes + balls {
@@ -428,7 +436,7 @@ pub fn pile_scene(
             out.1.push(dynamic_ball(world, 0.3, x)?);
         } else {
             let e = dynamic_box(world, Vec3::new(0.35, 0.25, 0.3), x)?;
-            if let Some(mut r) = world.get_mut::<crate::Rotation>(e) {
+            if let Some(mut r) = world.get_mut::<crate::rigid::Rotation>(e) {
                 r.0 = glam::Quat::from_scaled_axis(jitter(i + 7) * 1.0);
             }
             out.0.push(e);
@@ -491,7 +499,7 @@ pub fn squeeze_densities(ratio: f32) -> [f32; 4] {
 /// # Errors
 /// [`crate::Error::NotPositive`] or [`crate::Error::NonFinite`] for a bad `ratio`.
 pub fn squeeze(world: &mut World, ratio: f32) -> Result<[Entity; 3]> {
-    crate::error::positive("mass ratio", ratio)?;
+    crate::core::error::positive("mass ratio", ratio)?;
     let rho = squeeze_densities(ratio);
     let boxes = spawn_boxes_with_density(world, &squeeze_spec(), |i| rho[i])?;
     Ok([boxes[0], boxes[1], boxes[2]])
@@ -509,7 +517,7 @@ pub fn pinned_beam(
     cells: [usize; 3],
     material: crate::soft::Material,
     model: crate::soft::StrainModel,
-) -> Result<(crate::Nodes, crate::soft::SoftBody)> {
+) -> Result<(crate::particles::Nodes, crate::soft::SoftBody)> {
     use crate::soft::{CellSplit, SoftBody, TetMesh};
     let mesh = TetMesh::cuboid(Vec3::new(length, side, side), cells, CellSplit::Six)?;
     let (mut nodes, body) =
@@ -544,7 +552,7 @@ pub fn catenary_parameter(span: f64, length: f64) -> f64 {
 /// every force evaluation. Beam theory gives a tip deflection F L³ / (3 E I) = 4.000 mm.
 #[derive(Debug, Clone)]
 pub struct Cantilever {
-    /// The beam's entity ([`crate::Nodes`] and [`crate::soft::SoftBody`]).
+    /// The beam's entity ([`crate::particles::Nodes`] and [`crate::soft::SoftBody`]).
     pub body: Entity,
     /// The end nodes the load is shared by.
     pub tip: Vec<usize>,
@@ -553,7 +561,7 @@ pub struct Cantilever {
 #[derive(Resource, Clone)]
 struct TipLoad(Entity, Vec<usize>, f32);
 
-fn apply_tip_load(load: Res<TipLoad>, mut meshes: Query<&mut crate::Nodes>) {
+fn apply_tip_load(load: Res<TipLoad>, mut meshes: Query<&mut crate::particles::Nodes>) {
     let Ok(mut n) = meshes.get_mut(load.0) else {
         return;
     };
@@ -573,7 +581,7 @@ impl Cantilever {
         world: &mut World,
         cells: [usize; 3],
         model: crate::soft::StrainModel,
-        settings: crate::ImplicitEuler,
+        settings: crate::integrator::ImplicitEuler,
     ) -> Result<Self> {
         let material = crate::soft::Material::new(1e8, 0.0, 1000.0)?;
         let (nodes, body) = pinned_beam(1.0, 0.1, cells, material, model)?;
@@ -582,8 +590,8 @@ impl Cantilever {
             .collect();
         let body = world.spawn((nodes, body, settings)).id();
         world.insert_resource(TipLoad(body, tip.clone(), 10.0));
-        crate::schedule::add_force_systems(world, || {
-            apply_tip_load.in_set(crate::schedule::ForceSystems::User)
+        crate::core::schedule::add_force_systems(world, || {
+            apply_tip_load.in_set(crate::core::schedule::ForceSystems::User)
         });
         Ok(Self { body, tip })
     }
@@ -591,7 +599,7 @@ impl Cantilever {
     /// The mean downward deflection of the end nodes (m), if the beam is still there.
     #[must_use]
     pub fn deflection(&self, world: &World) -> Option<f32> {
-        let n = world.get::<crate::Nodes>(self.body)?;
+        let n = world.get::<crate::particles::Nodes>(self.body)?;
         let y: f32 = self.tip.iter().map(|&i| n.positions()[i].y).sum();
         Some(-y / self.tip.len() as f32)
     }
@@ -621,8 +629,8 @@ pub fn cloth_on_ball(world: &mut World, n: usize) -> Result<Entity> {
     ground(world)?;
     let cloth = cloth(world, n)?;
     world.spawn((
-        crate::RigidBodyBundle::fixed(Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY)?,
-        crate::Collider::ball(0.3)?,
+        crate::rigid::RigidBodyBundle::fixed(Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY)?,
+        crate::collision::Collider::ball(0.3)?,
     ));
     Ok(cloth)
 }
@@ -639,7 +647,7 @@ pub fn jelly(world: &mut World, x: Vec3, implicit: bool) -> Result<Entity> {
     let body = SoftBody::build(&mesh, x, material, StrainModel::Corotated)?;
     let mut e = world.spawn(body);
     if implicit {
-        e.insert(crate::ImplicitEuler::default());
+        e.insert(crate::integrator::ImplicitEuler::default());
     }
     Ok(e.id())
 }

@@ -21,19 +21,19 @@ use bevy_platform::collections::HashMap;
 
 use bevy_ecs::prelude::*;
 
-use crate::WorldPlugin;
 use crate::collision::{Collider, ContactSettings, Contacts};
+use crate::core::plugin::WorldPlugin;
+use crate::core::quarantine::Quarantined;
+use crate::core::schedule::{CollisionSystems, PhysicsSchedule, PrepareSystems, add_own_systems};
+use crate::core::time::PhysicsTime;
 use crate::particles::{ExternalForce, ExternalImpulse, LinearVelocity, Mass, Position};
-use crate::quarantine::Quarantined;
 use crate::rigid::{
     AngularMomentum, AngularVelocity, ExternalForceAtPoint, ExternalImpulseAtPoint, ExternalTorque,
     Rotation,
 };
-use crate::schedule::{CollisionSystems, PhysicsSchedule, PrepareSystems, add_own_systems};
 use crate::springs::Spring;
-use crate::time::PhysicsTime;
 
-pub use crate::rest::{SleepTimer, Sleeping, SleepingDisabled};
+pub use crate::core::rest::{SleepTimer, Sleeping, SleepingDisabled};
 
 /// When islands fall asleep.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
@@ -65,7 +65,7 @@ pub struct SleepPlugin;
 
 impl WorldPlugin for SleepPlugin {
     fn build(&self, world: &mut World) {
-        crate::restore::init::<SleepSettings>(world);
+        crate::core::restore::init::<SleepSettings>(world);
         add_own_systems(
             world,
             PhysicsSchedule,
@@ -308,7 +308,7 @@ struct IslandScratch {
 type SleepFilter = (
     With<Collider>,
     Without<Quarantined>,
-    Without<crate::ColliderOf>,
+    Without<crate::collision::ColliderOf>,
 );
 
 /// Timers, islands, and the sleep/wake decisions.

@@ -23,10 +23,11 @@
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 
-use crate::error::{Error, Result};
+use crate::PhysicsWorldExt;
+use crate::core::error::{Error, Result};
+use crate::core::time::PhysicsTime;
 use crate::particles::{LinearVelocity, Position};
 use crate::rigid::{AngularVelocity, Rotation};
-use crate::{PhysicsTime, PhysicsWorldExt};
 
 /// Running a physics world headless, and reading its bodies (implemented for [`World`]).
 pub trait PhysicsTestExt {
@@ -72,7 +73,7 @@ impl PhysicsTestExt for World {
     fn steps_for(&self, seconds: f64) -> Result<u64> {
         let time = self.get_resource::<PhysicsTime>().ok_or(Error::NoPhysics)?;
         // Checked as f32 (past f32::MAX it is infinite there too); counted in f64.
-        let t = crate::error::non_negative("run time", seconds as f32)?;
+        let t = crate::core::error::non_negative("run time", seconds as f32)?;
         let steps = (seconds / f64::from(time.dt())).round();
         // A finite but huge time (1e30 s) would be a loop no test ever leaves.
         if steps > f64::from(u32::MAX) {
@@ -128,7 +129,7 @@ impl PhysicsTestExt for World {
     }
 
     fn mass_of(&self, e: Entity) -> Option<f32> {
-        self.get::<crate::Mass>(e).map(|m| {
+        self.get::<crate::particles::Mass>(e).map(|m| {
             if m.is_pinned() {
                 f32::INFINITY
             } else {

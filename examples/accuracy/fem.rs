@@ -4,8 +4,8 @@ use std::time::Instant;
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use hooke::ImplicitEuler;
 use hooke::accuracy::{Measurement, Setting, SweepReport, world_for};
+use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
 use hooke::soft::{Material, StrainModel};
 
@@ -98,7 +98,7 @@ pub fn swinging_beam(quick: bool) -> hooke::Result<Problem> {
     struct Beam(Vec<usize>);
     let build = |w: &mut World| -> hooke::Result<()> {
         w.insert_resource(Gravity::new(Vec3::new(0.0, -9.81, 0.0))?);
-        w.resource_mut::<hooke::SleepSettings>().enabled = false;
+        w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
         let material = Material::new(1e5, 0.3, 1000.0)?;
         let (nodes, body) =
             hooke::scenes::pinned_beam(1.0, 0.2, [5, 1, 1], material, StrainModel::Corotated)?;

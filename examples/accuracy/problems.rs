@@ -3,12 +3,18 @@
 use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec2, DVec3, Quat, Vec3};
 use hooke::accuracy::{Measurement, Reference, Setting, Sweep, SweepReport, sweep, timed_run};
+use hooke::collision::Collider;
+use hooke::collision::Friction;
+use hooke::collision::Restitution;
+use hooke::core::schedule::{ForceSystems, add_force_systems};
 use hooke::prelude::*;
-use hooke::schedule::{ForceSystems, add_force_systems};
-use hooke::{
-    Collider, Friction, Inertia, MassProperties, OrientationUpdate, Restitution, RigidBodyBundle,
-    Rotation, StabilityPolicy, scenes,
-};
+use hooke::rigid::Inertia;
+use hooke::rigid::MassProperties;
+use hooke::rigid::OrientationUpdate;
+use hooke::rigid::RigidBodyBundle;
+use hooke::rigid::Rotation;
+use hooke::scenes;
+use hooke::springs::StabilityPolicy;
 
 /// One problem's sweep, with how its error is measured.
 pub struct Problem {
@@ -88,7 +94,7 @@ fn runs(quick: bool) -> u32 {
 /// switch a stiff spring to backward Euler and blur the dial).
 fn base(world: &mut World, g: Vec3) -> hooke::Result<()> {
     world.insert_resource(Gravity::new(g)?);
-    world.resource_mut::<hooke::SleepSettings>().enabled = false;
+    world.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     world.insert_resource(StabilityPolicy::Warn);
     Ok(())
 }
@@ -245,7 +251,7 @@ struct Orbiting;
 /// GM = 4π² m³/s²: a 1 m orbit takes 1 s.
 const GM: f32 = (std::f64::consts::TAU * std::f64::consts::TAU) as f32;
 
-fn attract(mut q: Query<(&Position, &mut hooke::Force), With<Orbiting>>) {
+fn attract(mut q: Query<(&Position, &mut hooke::particles::Force), With<Orbiting>>) {
     for (x, mut f) in &mut q {
         let r = x.0;
         let d = r.length();

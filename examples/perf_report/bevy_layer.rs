@@ -17,7 +17,7 @@ fn settings(world: &mut World) {
     world.insert_resource(PhysicsTime::new(1.0 / 60.0, 4).unwrap());
     world.insert_resource(Gravity::new(Vec3::new(0.0, -9.81, 0.0)).unwrap());
     world.resource_mut::<DiagnosticsSettings>().energy = false;
-    world.resource_mut::<hooke::SleepSettings>().enabled = false;
+    world.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
 }
 
 fn app(spawn: &dyn Fn(&mut World)) -> App {

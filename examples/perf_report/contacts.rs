@@ -14,7 +14,7 @@ use crate::timing::{Config, compare, line, median};
 
 fn ours(specs: &[BoxSpec]) -> (World, Vec<Entity>) {
     let mut world = crate::quiet_world(1.0 / 60.0, 4, Integrator::SymplecticEuler);
-    world.resource_mut::<hooke::SleepSettings>().enabled = false;
+    world.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     let boxes = scenes::spawn_boxes(&mut world, specs).unwrap();
     (world, boxes)
 }

@@ -186,7 +186,7 @@ fn cloth_springs(cfg: &Config, n: usize) {
     }
     let (ours, reference) = compare(
         cfg,
-        || world.run_schedule(hooke::ForceSchedule),
+        || world.run_schedule(hooke::core::schedule::ForceSchedule),
         || raw.force_pass(g),
     );
     line(
@@ -222,7 +222,7 @@ fn cloth_springs(cfg: &Config, n: usize) {
     world.spawn_batch(batch);
     let (ours, reference) = compare(
         cfg,
-        || world.run_schedule(hooke::ForceSchedule),
+        || world.run_schedule(hooke::core::schedule::ForceSchedule),
         || raw.force_pass(g),
     );
     line(
@@ -276,7 +276,7 @@ fn all_plugins_vs_needed(cfg: &Config, n: usize) {
     scenes::particle_cloud(&mut all, n).unwrap();
     let mut needed = World::new();
     needed.insert_resource(PhysicsTime::new(1.0 / 60.0, 1).unwrap());
-    needed.add_physics(hooke::GravityPlugin);
+    needed.add_physics(hooke::particles::GravityPlugin);
     needed.resource_mut::<DiagnosticsSettings>().energy = false;
     scenes::particle_cloud(&mut needed, n).unwrap();
     let (ours, reference) = compare(cfg, || all.step_physics(), || needed.step_physics());

@@ -4,8 +4,10 @@ use std::hint::black_box;
 
 use glam::{Quat, Vec3A};
 use hooke::prelude::*;
+use hooke::rigid::Inertia;
+use hooke::rigid::MassProperties;
 use hooke::rigid::free_rotation_split;
-use hooke::{Inertia, MassProperties, scenes};
+use hooke::scenes;
 use parry3d::shape::Cuboid;
 use rapier3d::prelude as rp;
 

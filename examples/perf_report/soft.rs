@@ -6,9 +6,10 @@ use std::hint::black_box;
 
 use bevy_ecs::prelude::*;
 use glam::{Mat3, Vec3, Vec3A};
+use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
+use hooke::scenes;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
-use hooke::{ImplicitEuler, scenes};
 
 use crate::timing::{Config, compare, line};
 
@@ -146,13 +147,13 @@ pub fn soft_lines(cfg: &Config) {
     let mut without = World::new();
     without.insert_resource(PhysicsTime::new(1.0 / 60.0, 4).unwrap());
     without
-        .add_physics(hooke::GravityPlugin)
-        .add_physics(hooke::DampingPlugin)
-        .add_physics(hooke::VelocityFieldPlugin)
-        .add_physics(hooke::SpringPlugin)
-        .add_physics(hooke::RigidBodyPlugin)
-        .add_physics(hooke::CollisionPlugin)
-        .add_physics(hooke::SleepPlugin);
+        .add_physics(hooke::particles::GravityPlugin)
+        .add_physics(hooke::particles::DampingPlugin)
+        .add_physics(hooke::particles::VelocityFieldPlugin)
+        .add_physics(hooke::springs::SpringPlugin)
+        .add_physics(hooke::rigid::RigidBodyPlugin)
+        .add_physics(hooke::collision::CollisionPlugin)
+        .add_physics(hooke::sleep::SleepPlugin);
     without.insert_resource(Gravity::new(Vec3::new(0.0, -9.81, 0.0)).unwrap());
     without.resource_mut::<DiagnosticsSettings>().energy = false;
     scenes::particle_cloud(&mut without, 100_000).unwrap();
@@ -368,7 +369,9 @@ pub fn strain_dial(cfg: &Config) {
         let (mut w, e, tip) = bar(model, 100.0, Vec3::ZERO);
         let each = 10.0 / tip.len() as f32;
         w.insert_resource(Tip(e, tip.clone(), each));
-        hooke::schedule::add_force_systems(&mut w, || tip_load.in_set(hooke::ForceSystems::User));
+        hooke::core::schedule::add_force_systems(&mut w, || {
+            tip_load.in_set(hooke::core::schedule::ForceSystems::User)
+        });
         w.step_physics();
         let n = w.get::<Nodes>(e).unwrap();
         let d = -tip.iter().map(|&i| n.positions()[i].y).sum::<f32>() / tip.len() as f32;

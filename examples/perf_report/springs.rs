@@ -3,14 +3,16 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::cloth::ClothBuilder;
+use hooke::integrator::ImplicitEuler;
+use hooke::integrator::ImplicitState;
 use hooke::prelude::*;
-use hooke::{ClothBuilder, ImplicitEuler, ImplicitState};
 
 use crate::timing::{Config, compare, line};
 
 fn world(substeps: u32) -> World {
     let mut w = crate::quiet_world(1.0 / 60.0, substeps, Integrator::SymplecticEuler);
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     w
 }
 
@@ -167,7 +169,7 @@ pub fn cloth_vs_rapier(cfg: &Config, steps: usize) {
             let (nodes, net, cloth) = (
                 w.get::<Nodes>(e).unwrap(),
                 w.get::<SpringNetwork>(e).unwrap(),
-                w.get::<hooke::Cloth>(e).unwrap(),
+                w.get::<hooke::cloth::Cloth>(e).unwrap(),
             );
             cloth.max_strain(nodes, net)
         };

@@ -5,7 +5,7 @@ use bevy_diagnostic::{Diagnostic, DiagnosticPath, Diagnostics, RegisterDiagnosti
 use bevy_ecs::prelude::*;
 
 use super::{AppSchedule, PhysicsAppSystems};
-use crate::PhysicsDiagnostics;
+use crate::core::diagnostics::PhysicsDiagnostics;
 
 /// Feeds the last step's [`PhysicsDiagnostics`] into `bevy_diagnostic` under `hooke/…`
 /// paths (see the associated constants), once per physics step.

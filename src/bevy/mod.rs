@@ -21,9 +21,9 @@
 //!
 //! - **One clock.** [`PhysicsSchedulePlugin`] runs one physics step per tick of its schedule
 //!   (`FixedPostUpdate` by default) with dt = `Time<Fixed>::delta`, and sets
-//!   [`PhysicsTime::elapsed`](crate::PhysicsTime::elapsed) to `Time<Fixed>::elapsed` after
+//!   [`PhysicsTime::elapsed`](crate::core::time::PhysicsTime::elapsed) to `Time<Fixed>::elapsed` after
 //!   each step, so the two never drift. Change the rate with `Time::<Fixed>::from_hz(..)`;
-//!   [`PhysicsTime::substeps`](crate::PhysicsTime::substeps) still splits each step.
+//!   [`PhysicsTime::substeps`](crate::core::time::PhysicsTime::substeps) still splits each step.
 //! - **Transforms.** [`PhysicsTransformPlugin`] reads a body's or collider's `Transform` when
 //!   something other than hooke wrote it (so writing a `Transform` moves a body or a static
 //!   collider: no insert-versus-write trap) and writes it back after every step, with the
@@ -32,13 +32,13 @@
 //! - **Interpolation.** [`PhysicsInterpolationPlugin`] moves the `Transform` of entities with
 //!   [`TransformInterpolation`] (or [`TransformExtrapolation`]) between fixed steps, every
 //!   frame.
-//! - **Messages.** [`crate::ContactStarted`], [`crate::ContactEnded`] and
-//!   [`crate::BodyQuarantined`] are registered with the App, which keeps them until two
+//! - **Messages.** [`crate::collision::ContactStarted`], [`crate::collision::ContactEnded`] and
+//!   [`crate::core::quarantine::BodyQuarantined`] are registered with the App, which keeps them until two
 //!   frames that ran a fixed step have passed: a `MessageReader` in `Update` sees every one
-//!   however many steps a frame ran. Bodies with [`crate::CollisionEventsEnabled`] also get
-//!   [`crate::ContactStart`] / [`crate::ContactEnd`] entity events for observers.
+//!   however many steps a frame ran. Bodies with [`crate::collision::CollisionEventsEnabled`] also get
+//!   [`crate::collision::ContactStart`] / [`crate::collision::ContactEnd`] entity events for observers.
 //! - **Diagnostics.** [`PhysicsDiagnosticsPlugin`] (not in the group; add it beside
-//!   `bevy_diagnostic`'s `DiagnosticsPlugin`) feeds [`crate::PhysicsDiagnostics`] into the
+//!   `bevy_diagnostic`'s `DiagnosticsPlugin`) feeds [`crate::core::diagnostics::PhysicsDiagnostics`] into the
 //!   `DiagnosticsStore`.
 //!
 //! Every hooke effect plugin is also a Bevy plugin, so `app.add_plugins((GravityPlugin,
@@ -62,13 +62,22 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
 use bevy_time::{Fixed, Time};
 
+use crate::PhysicsPlugins;
+use crate::PhysicsWorldExt;
 use crate::cloth::ClothPlugin;
+use crate::collision::CollisionPlugin;
+use crate::collision::ContactEnded;
+use crate::collision::ContactStarted;
+use crate::core::plugin::PhysicsCorePlugin;
+use crate::core::quarantine::BodyQuarantined;
+use crate::core::time::PhysicsTime;
+use crate::particles::DampingPlugin;
+use crate::particles::GravityPlugin;
+use crate::particles::VelocityFieldPlugin;
+use crate::rigid::RigidBodyPlugin;
+use crate::sleep::SleepPlugin;
 use crate::soft::SoftBodyPlugin;
-use crate::{
-    BodyQuarantined, CollisionPlugin, ContactEnded, ContactStarted, DampingPlugin, GravityPlugin,
-    PhysicsCorePlugin, PhysicsPlugins, PhysicsTime, PhysicsWorldExt, RigidBodyPlugin, SleepPlugin,
-    SpringPlugin, VelocityFieldPlugin,
-};
+use crate::springs::SpringPlugin;
 
 /// The sets hooke's App systems run in, in order, inside the physics schedule
 /// ([`PhysicsSchedulePlugin::schedule`]). Put gameplay systems that must see the new poses
@@ -77,7 +86,7 @@ use crate::{
 pub enum PhysicsAppSystems {
     /// `Transform`s written by game code become physics poses.
     ReadTransforms,
-    /// One physics step ([`crate::PhysicsSchedule`]).
+    /// One physics step ([`crate::core::schedule::PhysicsSchedule`]).
     Step,
     /// Physics poses become `Transform`s; interpolation records the step's poses.
     Writeback,
@@ -126,9 +135,9 @@ fn register_messages(world: &mut World) {
     MessageRegistry::register_message::<ContactStarted>(world);
     MessageRegistry::register_message::<ContactEnded>(world);
     MessageRegistry::register_message::<BodyQuarantined>(world);
-    MessageRegistry::register_message::<crate::StabilityWarning>(world);
-    MessageRegistry::register_message::<crate::restore::ResourceRestored>(world);
-    MessageRegistry::register_message::<crate::restore::InvalidSetting>(world);
+    MessageRegistry::register_message::<crate::springs::StabilityWarning>(world);
+    MessageRegistry::register_message::<crate::core::restore::ResourceRestored>(world);
+    MessageRegistry::register_message::<crate::core::restore::InvalidSetting>(world);
     world.insert_resource(MessagesRegistered);
 }
 
@@ -170,7 +179,7 @@ fn step(world: &mut World) {
         return;
     }
     time.follow(dt, start);
-    crate::run_step(world);
+    crate::core::plugin::run_step(world);
     if let Some(mut time) = world.get_resource_mut::<PhysicsTime>() {
         time.set_elapsed(end);
     }

@@ -21,8 +21,8 @@ use glam::{Quat, Vec3, Vec3A};
 use super::interpolation::PoseHistory;
 use super::{AppSchedule, PhysicsAppSystems};
 use crate::collision::{Collider, ColliderOf, ColliderOffset};
+use crate::core::quarantine::Quarantined;
 use crate::particles::{LinearVelocity, Mass, Position};
-use crate::quarantine::Quarantined;
 use crate::rigid::{CenterOfMass, RigidBody, Rotation};
 
 /// Reads written `Transform`s before each step and writes poses back after it.

@@ -4,7 +4,7 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 
 use super::Cloth;
-use crate::error::{Error, Result, positive};
+use crate::core::error::{Error, Result, positive};
 use crate::particles::Nodes;
 use crate::springs::SpringNetwork;
 

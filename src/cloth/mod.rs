@@ -2,15 +2,15 @@
 //! limiting, collisions and what a renderer needs.
 //!
 //! The springs are the spring module's (the same [`crate::springs::spring_force`], explicit or
-//! in the backward-Euler solve with [`crate::ImplicitEuler`]); [`Cloth`] adds the surface:
+//! in the backward-Euler solve with [`crate::integrator::ImplicitEuler`]); [`Cloth`] adds the surface:
 //!
-//! - **Generators.** [`crate::ClothBuilder`] makes a grid (structural, shear and bend
+//! - **Generators.** [`crate::cloth::ClothBuilder`] makes a grid (structural, shear and bend
 //!   springs); [`Cloth::from_triangles`] any triangle mesh: a structural spring per edge and a
 //!   bending spring across each edge two triangles share (between their opposite corners).
 //!   A triangle mesh's edges carry its shear. Nodes get the lumped mass ρ A / 3 of each
 //!   triangle touching them (ρ in kg/m²).
 //! - **Wind and drag.** Each triangle of area A and unit normal n̂ moving at v (its corners'
-//!   mean) through air moving at u (the sum of the world's [`crate::VelocityField`]s at its
+//!   mean) through air moving at u (the sum of the world's [`crate::particles::VelocityField`]s at its
 //!   centroid) feels f = −c_d A ((v − u)·n̂) n̂, shared by its corners: air pushes on the
 //!   cloth's face only, so a flag in a steady wind streams out and flutters.
 //! - **Strain limiting** (Provot 1995). After each substep, a structural spring stretched past
@@ -33,7 +33,7 @@ pub use plugin::ClothPlugin;
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 
-use crate::error::{Error, Result, finite_vec, non_negative, positive};
+use crate::core::error::{Error, Result, finite_vec, non_negative, positive};
 use crate::integrator::implicit::ContactPlane;
 use crate::particles::Nodes;
 use crate::springs::SpringNetwork;

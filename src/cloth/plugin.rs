@@ -4,17 +4,18 @@ use bevy_ecs::prelude::*;
 use glam::Vec3A;
 
 use super::Cloth;
-use crate::particles::{Nodes, VelocityField};
-use crate::quarantine::{QuarantineReason, Quarantined};
-use crate::schedule::{
+use crate::Error;
+use crate::core::plugin::WorldPlugin;
+use crate::core::quarantine::{QuarantineReason, Quarantined};
+use crate::core::schedule::{
     FinishSystems, ForceSystems, PhysicsSchedule, RelaxSystems, SubstepSchedule,
     add_own_force_systems, add_own_systems,
 };
+use crate::core::time::PhysicsTime;
+use crate::particles::{Nodes, VelocityField};
 use crate::springs::SpringNetwork;
-use crate::time::PhysicsTime;
-use crate::{Error, WorldPlugin};
 
-type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
+type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 /// Gauss–Seidel passes of strain limiting per substep at most; they stop once no spring is
 /// more than 0.1 % past its limit. A long chain of over-stretched springs needs about as
@@ -30,7 +31,7 @@ pub struct ClothPlugin;
 
 impl WorldPlugin for ClothPlugin {
     fn build(&self, world: &mut World) {
-        crate::whole_step::block_on::<Cloth>(world);
+        crate::core::whole_step::block_on::<Cloth>(world);
         add_own_force_systems(world, || {
             apply_wind
                 .run_if(any_with_component::<Cloth>)

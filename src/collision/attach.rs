@@ -6,7 +6,7 @@
 //! [`ColliderDensity`] ρᵢ (default [`ColliderDensity::DEFAULT`] = 1000 kg/m³, water; a
 //! 1 m cube weighs a tonne), the parts combined about their common centre of mass by the
 //! parallel-axis theorem. Mass properties you give (a [`Mass`] or a
-//! [`crate::RigidBodyBundle`]) are never overwritten.
+//! [`crate::rigid::RigidBodyBundle`]) are never overwritten.
 //!
 //! **Child colliders.** A [`Collider`] on an entity whose parent (`ChildOf`, at any depth)
 //! is a body is part of that body: it sits at its [`ColliderOffset`] in the parent's frame
@@ -17,8 +17,8 @@
 //! the body. A part that is itself composite (a compound, trimesh or heightfield) cannot be
 //! nested in a compound: that child is quarantined with [`Error::CompositePart`].
 //!
-//! A part's own [`crate::Friction`], [`crate::Restitution`], [`crate::CollisionLayers`] and
-//! [`crate::Sensor`] are not read: the body's apply to all its parts.
+//! A part's own [`crate::collision::Friction`], [`crate::collision::Restitution`], [`crate::collision::CollisionLayers`] and
+//! [`crate::collision::Sensor`] are not read: the body's apply to all its parts.
 //!
 //! Changes are seen when they are inserted: a new collider, density or offset, a despawned
 //! or re-parented child, a new [`RigidBody`] kind. The work is done by a command queued from
@@ -34,9 +34,9 @@ use parry3d::math::Pose;
 use parry3d::shape::{SharedShape, TypedShape};
 
 use super::Collider;
-use crate::error::{Error, Result, finite_vec, positive};
+use crate::core::error::{Error, Result, finite_vec, positive};
+use crate::core::quarantine::{QuarantineReason, Quarantined, Validate, validate_on_insert};
 use crate::particles::{Mass, Position};
-use crate::quarantine::{QuarantineReason, Quarantined, Validate, validate_on_insert};
 use crate::rigid::{CenterOfMass, ComputedMass, Inertia, RigidBody, Rotation};
 
 /// Density of a collider (kg/m³), used when hooke computes a body's mass from its colliders.
@@ -454,13 +454,13 @@ fn set_mass(world: &mut World, body: Entity, parts: &[Part]) {
     crate::rigid::insert_computed_mass(world, body, props);
 }
 
-fn mass_from_parry(p: &ParryMass) -> Result<crate::MassProperties> {
+fn mass_from_parry(p: &ParryMass) -> Result<crate::rigid::MassProperties> {
     let mass = p.mass();
     if !(mass.is_finite() && mass > 0.0) {
         return Err(Error::InvalidMass(mass));
     }
     let inertia = Inertia::new(p.principal_inertia(), p.principal_inertia_local_frame)?;
-    crate::MassProperties::new(mass, p.local_com, inertia)
+    crate::rigid::MassProperties::new(mass, p.local_com, inertia)
 }
 
 /// After a step: every attached collider's [`Position`] and [`Rotation`] at its world pose.

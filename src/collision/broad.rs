@@ -19,8 +19,8 @@ use glam::Vec3;
 use parry3d::bounding_volume::Aabb;
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
 
+use crate::core::quarantine::Quarantined;
 use crate::particles::{LinearVelocity, Position};
-use crate::quarantine::Quarantined;
 use crate::rigid::Rotation;
 
 use super::CollisionLayers;

@@ -19,9 +19,9 @@ use bevy_ecs::prelude::*;
 use glam::{DVec3, Mat3, Quat, Vec3, Vec3A};
 use nalgebra::DMatrix;
 
+use crate::core::quarantine::Quarantined;
 use crate::integrator::skyline::SkylineCholesky;
 use crate::particles::{LinearVelocity, Mass, Nodes};
-use crate::quarantine::Quarantined;
 use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, Rotation};
 
 /// The soft body's response G_soft for impulses along `rows` = (node, unit direction): one

@@ -20,8 +20,8 @@ use bevy_ecs::prelude::*;
 use glam::{Mat3A, Vec3A};
 
 use super::solver::{BodyState, ContactSolver};
+use crate::core::quarantine::Quarantined;
 use crate::particles::{LinearVelocity, Position};
-use crate::quarantine::Quarantined;
 use crate::rigid::{AngularMomentum, AngularVelocity, Rotation};
 
 /// A query position that holds no solver body.

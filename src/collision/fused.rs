@@ -1,7 +1,7 @@
 //! The whole step of a world of rigid bodies under constant forces, in the contact solver's
-//! own arrays (see [`crate::whole_step`] for when it runs).
+//! own arrays (see [`crate::core::whole_step`] for when it runs).
 //!
-//! Per substep of length h, for every live body, exactly as [`crate::SubstepSchedule`] does:
+//! Per substep of length h, for every live body, exactly as [`crate::core::schedule::SubstepSchedule`] does:
 //!
 //! ```text
 //! v ← v + h f/m,  L ← L + h τ              f = f_ext + m g s, τ = τ_ext (constant)
@@ -24,23 +24,23 @@ use super::exchange::{read_values, write_values};
 use super::narrow::Contacts;
 use super::plugin::{biased_pass, relax_pass};
 use super::solver::ContactSolver;
+use crate::core::quarantine::{DivergenceGuard, QuarantineReason, Quarantined};
+use crate::core::time::{PhysicsTime, SubstepTime};
 use crate::integrator::{Integrator, constant_force, drift, kick};
 use crate::particles::{
     ExternalForce, Force, Gravity, GravityScale, LinearVelocity, Mass, Position,
 };
-use crate::quarantine::{DivergenceGuard, QuarantineReason, Quarantined};
 use crate::rigid::{
     AngularMomentum, AngularVelocity, ExternalTorque, Inertia, OrientationUpdate, Renormalization,
     Rotation, Torque, free_rotation_split, turn,
 };
-use crate::time::{PhysicsTime, SubstepTime};
 
 /// Registers the path; called by the collision plugin.
 pub(super) fn install(world: &mut World) {
     let state = SystemState::<Params>::new(world);
     world.insert_resource(Cache(Some(state)));
-    world.insert_resource(crate::whole_step::WholeStepRunner(run));
-    crate::whole_step::block_on::<super::coupling::NodeImpulse>(world);
+    world.insert_resource(crate::core::whole_step::WholeStepRunner(run));
+    crate::core::whole_step::block_on::<super::coupling::NodeImpulse>(world);
 }
 
 type Body<'a> = (
@@ -59,7 +59,7 @@ type Body<'a> = (
 );
 
 /// What the schedule's integrators move: not quarantined, not asleep.
-type Moving = (Without<Quarantined>, Without<crate::rest::Sleeping>);
+type Moving = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 type Params = (
     Commands<'static, 'static>,

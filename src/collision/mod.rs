@@ -1,7 +1,7 @@
 //! Collisions through parry: colliders, broad phase, narrow phase and a soft-step contact
 //! solver.
 //!
-//! **Pipeline, once per step** (in [`crate::schedule::PrepareSystems::Collision`]):
+//! **Pipeline, once per step** (in [`crate::core::schedule::PrepareSystems::Collision`]):
 //! 1. bounding boxes of moving colliders, grown by the distance they can travel in the step
 //!    (the *speculative margin*, so fast bodies find what they would hit);
 //! 2. broad phase: incremental sort-and-sweep over moving boxes and a tree of fixed ones
@@ -23,7 +23,7 @@
 //! the contacts are warm-started and solved with a soft position bias (spring of
 //! [`ContactSettings::hertz`], damping ratio [`ContactSettings::damping_ratio`], push-out at
 //! most [`ContactSettings::max_push_velocity`]); positions are integrated; then
-//! [`crate::StepSystems::RelaxConstraints`] solves once more without bias so that the
+//! [`crate::core::schedule::StepSystems::RelaxConstraints`] solves once more without bias so that the
 //! push-out does not stay in the velocities. After the last substep, restitution brings the
 //! normal velocity of every contact that hit faster than [`ContactSettings::restitution_threshold`]
 //! to −e times its approach speed (Newton's law), but never past the impulse that ends its
@@ -51,7 +51,7 @@
 //! bodies are solved once more after each pass: a heap spawned at one point spreads out on
 //! the ground instead of exploding through it.
 //!
-//! **Bodies.** A [`Collider`] on a body with a finite [`crate::Mass`] is dynamic; on a pinned
+//! **Bodies.** A [`Collider`] on a body with a finite [`crate::particles::Mass`] is dynamic; on a pinned
 //! or massless entity it is static (a kinematic body's velocity still drives its contacts).
 //! A particle with a ball collider collides like any body but never rotates.
 //!
@@ -115,14 +115,14 @@ use glam::{Quat, Vec3};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
-use crate::error::{Error, Result, finite, finite_vec, non_negative};
+use crate::core::error::{Error, Result, finite, finite_vec, non_negative};
 
+use crate::core::quarantine::{Validate, validate_on_insert};
 use crate::particles::Position;
-use crate::quarantine::{Validate, validate_on_insert};
 use crate::rigid::Rotation;
 
 /// A collision shape (a parry shape) attached to a body, placed at the body's shape frame:
-/// origin x − R c, where c is the [`crate::CenterOfMass`].
+/// origin x − R c, where c is the [`crate::rigid::CenterOfMass`].
 #[derive(serde::Serialize, serde::Deserialize, Component, Clone)]
 #[serde(try_from = "ColliderRecord", into = "ColliderRecord")]
 #[require(
@@ -132,7 +132,7 @@ use crate::rigid::Rotation;
     Restitution,
     CollisionLayers,
     ColliderAabb,
-    crate::rest::SleepTimer
+    crate::core::rest::SleepTimer
 )]
 #[cfg_attr(feature = "bevy", require(bevy_transform::components::Transform))]
 #[component(on_insert = collider_changed, on_remove = collider_changed)]
@@ -459,7 +459,7 @@ impl Collider {
 }
 
 fn positive_len(what: &'static str, v: f32) -> Result<f32> {
-    crate::error::positive(what, v)
+    crate::core::error::positive(what, v)
 }
 
 /// Coulomb friction coefficient μ (dimensionless, default 0.5).

@@ -6,10 +6,10 @@
 //! to a collider's surface (or inside it)
 //! is moved out along the surface normal n to that distance; its velocity loses its
 //! approaching normal part Δvₙ, and its tangential part is reduced by μ Δvₙ (Coulomb's cone,
-//! μ the collider's [`crate::Friction`]), stopping it when the cone holds.
+//! μ the collider's [`crate::collision::Friction`]), stopping it when the cone holds.
 //!
 //! Against a kinematic collider the same holds relative to its surface's velocity. Under
-//! [`crate::ImplicitEuler`] each such contact is also a plane the next solve holds the node
+//! [`crate::integrator::ImplicitEuler`] each such contact is also a plane the next solve holds the node
 //! to (moving with the surface).
 //!
 //! **Two-way with dynamic bodies.** The nodes in a dynamic body's contact layer are pushed out
@@ -37,13 +37,13 @@ use parry3d::math::Pose;
 
 use super::coupling::{NodeImpulse, RigidSide, move_soft, soft_response};
 use crate::collision::{Collider, ColliderAabb, ColliderOf, Friction};
+use crate::core::quarantine::Quarantined;
+use crate::core::time::SubstepTime;
 use crate::integrator::implicit::ContactPlane;
 use crate::integrator::skyline::SkylineCholesky;
 use crate::integrator::{ImplicitEuler, ImplicitState};
 use crate::particles::{LinearVelocity, Mass, Nodes, Position};
-use crate::quarantine::Quarantined;
 use crate::rigid::{AngularVelocity, CenterOfMass, Inertia, Rotation};
-use crate::time::SubstepTime;
 
 /// The most nodes in one dynamic body's layer whose impulses are found with the soft body's
 /// full response (one factor solve each); past it, with the lumped masses.

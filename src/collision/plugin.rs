@@ -14,14 +14,14 @@ use super::solver::{ContactSolver, Softness};
 use super::{
     Collider, ColliderAabb, CollisionLayers, ContactEnded, ContactSettings, ContactStarted, Sensor,
 };
-use crate::WorldPlugin;
-use crate::particles::{LinearVelocity, Position};
-use crate::rest::Sleeping;
-use crate::rigid::{AngularVelocity, CenterOfMass, Rotation};
-use crate::schedule::{
+use crate::core::plugin::WorldPlugin;
+use crate::core::rest::Sleeping;
+use crate::core::schedule::{
     CollisionSystems, PhysicsSchedule, StepSystems, SubstepSchedule, add_own_systems,
 };
-use crate::time::{PhysicsTime, SubstepTime};
+use crate::core::time::{PhysicsTime, SubstepTime};
+use crate::particles::{LinearVelocity, Position};
+use crate::rigid::{AngularVelocity, CenterOfMass, Rotation};
 
 /// Colliders, contacts and the contact solver. Every system runs only while a collider
 /// exists; the solver only while some contact does.
@@ -30,7 +30,7 @@ pub struct CollisionPlugin;
 
 impl WorldPlugin for CollisionPlugin {
     fn build(&self, world: &mut World) {
-        crate::restore::init::<ContactSettings>(world);
+        crate::core::restore::init::<ContactSettings>(world);
         super::fused::install(world);
         add_own_systems(
             world,
@@ -39,22 +39,22 @@ impl WorldPlugin for CollisionPlugin {
                 correct_contact_settings,
                 super::attach::refresh_written_parts,
             )
-                .in_set(crate::schedule::PrepareSystems::Inputs),
+                .in_set(crate::core::schedule::PrepareSystems::Inputs),
         );
-        crate::restore::init::<super::ColliderChanges>(world);
-        crate::restore::init::<BroadPhase>(world);
-        crate::restore::init::<Contacts>(world);
-        crate::restore::init::<ContactSolver>(world);
-        crate::restore::init::<bevy_ecs::message::Messages<ContactStarted>>(world);
-        crate::restore::init::<bevy_ecs::message::Messages<ContactEnded>>(world);
+        crate::core::restore::init::<super::ColliderChanges>(world);
+        crate::core::restore::init::<BroadPhase>(world);
+        crate::core::restore::init::<Contacts>(world);
+        crate::core::restore::init::<ContactSolver>(world);
+        crate::core::plugin::add_message::<ContactStarted>(world);
+        crate::core::plugin::add_message::<ContactEnded>(world);
         // Impulses from mesh nodes (soft bodies, cloth) reach their bodies at the start of the
         // next substep, before the bodies' own integrators.
         add_own_systems(
             world,
-            crate::schedule::SubstepSchedule,
+            crate::core::schedule::SubstepSchedule,
             super::coupling::apply_node_impulses
                 .run_if(any_with_component::<super::coupling::NodeImpulse>)
-                .in_set(crate::schedule::StepSystems::AccumulateTorque),
+                .in_set(crate::core::schedule::StepSystems::AccumulateTorque),
         );
         world.add_observer(super::broad::on_body_inserted);
         world.add_observer(super::broad::on_body_removed);
@@ -66,7 +66,7 @@ impl WorldPlugin for CollisionPlugin {
             PhysicsSchedule,
             super::attach::place_attached_colliders
                 .run_if(any_with_component::<super::ColliderOf>)
-                .in_set(crate::schedule::FinishSystems::Writeback),
+                .in_set(crate::core::schedule::FinishSystems::Writeback),
         );
         add_own_systems(
             world,
@@ -96,7 +96,7 @@ impl WorldPlugin for CollisionPlugin {
                     .in_set(StepSystems::SolveConstraints),
                 relax_contacts
                     .run_if(contacts_active)
-                    .in_set(crate::schedule::RelaxSystems::Rigid),
+                    .in_set(crate::core::schedule::RelaxSystems::Rigid),
             ),
         );
     }
@@ -496,8 +496,10 @@ fn update_contacts(
                 if body.moving {
                     commands
                         .entity(side)
-                        .try_insert(crate::quarantine::Quarantined {
-                            reason: crate::quarantine::QuarantineReason::GeometryFailed { other },
+                        .try_insert(crate::core::quarantine::Quarantined {
+                            reason: crate::core::quarantine::QuarantineReason::GeometryFailed {
+                                other,
+                            },
                         });
                 }
             }
@@ -648,12 +650,12 @@ pub(super) fn relax_pass(
 }
 
 /// Settings written with bad values (NaN, negative) are put back to their defaults, field by
-/// field, each with an [`InvalidSetting`](crate::restore::InvalidSetting) message: a NaN
+/// field, each with an [`InvalidSetting`](crate::core::restore::InvalidSetting) message: a NaN
 /// `max_push_velocity` or a negative `margin` dropped bodies through the ground, a negative
 /// damping ratio exploded a stack. Runs only in a step after the resource changed.
 fn correct_contact_settings(
     mut settings: ResMut<ContactSettings>,
-    mut invalid: MessageWriter<crate::restore::InvalidSetting>,
+    mut invalid: MessageWriter<crate::core::restore::InvalidSetting>,
     mut bp: ResMut<BroadPhase>,
 ) {
     if !settings.is_changed() {
@@ -697,7 +699,7 @@ fn correct_contact_settings(
             continue;
         }
         any = true;
-        invalid.write(crate::restore::InvalidSetting {
+        invalid.write(crate::core::restore::InvalidSetting {
             resource: "ContactSettings",
             field,
             value,

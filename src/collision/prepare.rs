@@ -13,9 +13,9 @@ use super::plugin::{part_pose, shape_pose};
 use super::points::MAX_POINTS;
 use super::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, SolverBody};
 use super::{Collider, ContactSettings, Friction, Restitution, RestitutionThreshold};
+use crate::core::rest::Sleeping;
 use crate::integrator::ConstraintsActive;
 use crate::particles::{LinearVelocity, Mass, Position};
-use crate::rest::Sleeping;
 use crate::rigid::{AngularVelocity, CenterOfMass, Inertia, Rotation};
 
 /// Constraint building's reused buffers: the bodies of the step's contacts, the contact
@@ -67,7 +67,7 @@ pub(super) struct Side {
     inertia: Option<Inertia>,
     /// A material written with a bad value (through `get_mut`): the body is quarantined and
     /// this step's contacts use the defaults.
-    bad_material: Option<crate::error::Error>,
+    bad_material: Option<crate::core::error::Error>,
 }
 
 impl Side {
@@ -91,7 +91,7 @@ impl Side {
         ) = body;
         // Checked where they are used, once per body in contact: a pass over every
         // collider's `Changed` materials cost 16–36 µs a step among 10,000 idle statics.
-        use crate::quarantine::Validate;
+        use crate::core::quarantine::Validate;
         // A chain, not an array of four `Option<Error>`s: moving the errors through an
         // array cost about a hundred instructions per body even when all were `None`.
         let bad_material = friction
@@ -294,8 +294,8 @@ pub(super) fn prepare_contacts(
         if let Some(err) = &side.bad_material {
             commands
                 .entity(side.entity)
-                .try_insert(crate::quarantine::Quarantined {
-                    reason: crate::quarantine::QuarantineReason::InvalidInput(err.clone()),
+                .try_insert(crate::core::quarantine::Quarantined {
+                    reason: crate::core::quarantine::QuarantineReason::InvalidInput(err.clone()),
                 });
         }
     }

@@ -12,8 +12,8 @@ use parry3d::math::Pose;
 use parry3d::query::{Ray, ShapeCastOptions};
 
 use super::{Collider, ColliderAabb, CollisionLayers, Sensor};
+use crate::core::quarantine::Quarantined;
 use crate::particles::Position;
-use crate::quarantine::Quarantined;
 use crate::rigid::{CenterOfMass, Rotation};
 
 /// Which colliders a query sees.
@@ -319,7 +319,7 @@ impl SpatialQuery<'_, '_> {
 /// `q` as a unit quaternion; none for a zero or non-finite one (whose "normalised" form is
 /// NaN and made every query answer with NaN hits).
 fn unit_rotation(q: Quat) -> Option<Quat> {
-    crate::Rotation::try_new(q).ok().map(|r| r.0)
+    crate::rigid::Rotation::try_new(q).ok().map(|r| r.0)
 }
 
 /// Runs a parry query, with a panic inside parry (seen on shapes at the edge of its domain)

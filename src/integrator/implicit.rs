@@ -1,7 +1,7 @@
 //! Backward Euler for meshes: Newton on the incremental potential with a preconditioned
 //! conjugate-gradient solve, shared by every effect whose elements can say their energy,
 //! forces and stiffness ([`ImplicitElements`]: soft bodies' tetrahedra, spring networks'
-//! springs). See [`crate::ImplicitEuler`].
+//! springs). See [`crate::integrator::ImplicitEuler`].
 //!
 //! For a substep h, with y = x₀ + h v₀ and D = α M + Σₖ Dₖ (mass-proportional damping and the
 //! elements' own damping matrices at the step's start):

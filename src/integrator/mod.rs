@@ -19,7 +19,7 @@
 //! reuse of a(x₁) as the next step's a₀ is wrong for velocity-dependent forces (damping), and
 //! the substep schedule evaluates forces at the start of every substep anyway.
 //!
-//! Multi-stage integrators never copy force code: they re-run [`crate::schedule::ForceSchedule`]
+//! Multi-stage integrators never copy force code: they re-run [`crate::core::schedule::ForceSchedule`]
 //! (the same systems as the substep's force sets) at each stage state.
 //!
 //! **Mixing integrators.** The [`Integrator`] resource sets the default and an
@@ -42,8 +42,8 @@ pub(crate) use plugin::{constant_force, mesh_divergence};
 
 /// Meshes the explicit integrators advance: alive, awake, and not solved implicitly.
 pub(crate) type ExplicitMesh = (
-    Without<crate::quarantine::Quarantined>,
-    Without<crate::rest::Sleeping>,
+    Without<crate::core::quarantine::Quarantined>,
+    Without<crate::core::rest::Sleeping>,
     Without<ImplicitEuler>,
 );
 pub use stages::{AngularRk4, Rk4Scratch};
@@ -66,7 +66,7 @@ pub enum Integrator {
     VelocityVerlet,
     /// Classic fourth-order Runge–Kutta. Four force evaluations; slowly loses energy.
     Rk4,
-    /// Backward Euler: unconditionally stable, first order, damps. Springs ([`crate::Spring`]
+    /// Backward Euler: unconditionally stable, first order, damps. Springs ([`crate::springs::Spring`]
     /// entities and `SpringNetwork` meshes) and soft bodies are solved by Newton's method
     /// ([`ImplicitEuler`] holds the solver's settings); every other force is integrated as
     /// by symplectic Euler, which for forces that do not depend on the state is the same

@@ -4,21 +4,26 @@ use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 
 use super::{Integrator, IntegratorOverride, drift, explicit_euler, kick};
+use crate::core::plugin::WorldPlugin;
+use crate::core::quarantine::{
+    DivergenceGuard, QuarantineReason, Quarantined, quarantine_non_finite,
+};
+use crate::core::schedule::{
+    IntegrationSystems, PhysicsSchedule, PrepareSystems, StepSystems, SubstepSchedule,
+    add_own_force_systems, add_own_systems,
+};
+use crate::core::time::SubstepTime;
 use crate::particles::{
     ExternalForce, ExternalImpulse, Force, Gravity, GravityScale, LinearVelocity, Mass, Nodes,
-    Position,
+    Position, Tracer,
 };
-use crate::quarantine::{DivergenceGuard, QuarantineReason, Quarantined, quarantine_non_finite};
 use crate::rigid::{
     AngularMomentum, CenterOfMass, ExternalImpulseAtPoint, ExternalTorque, Inertia, Rotation,
     Torque, world_point,
 };
-use crate::schedule::{IntegrationSystems, StepSystems, add_own_force_systems, add_own_systems};
-use crate::time::SubstepTime;
-use crate::{SubstepSchedule, WorldPlugin};
 
 /// Whether any constraint (contact, joint) acts in this step. Constraint plugins set it in
-/// [`crate::PhysicsSystems::Prepare`]. While it is false nothing runs between the velocity and
+/// [`crate::core::schedule::PhysicsSystems::Prepare`]. While it is false nothing runs between the velocity and
 /// the position half of symplectic Euler, so particles take both halves in one pass: the same
 /// arithmetic, bit for bit, with one read of memory instead of two.
 #[derive(
@@ -39,13 +44,21 @@ pub struct IntegratorPlugin;
 
 impl WorldPlugin for IntegratorPlugin {
     fn build(&self, world: &mut World) {
-        crate::restore::init::<Integrator>(world);
-        crate::restore::init::<ConstraintsActive>(world);
+        crate::core::restore::init::<Integrator>(world);
+        crate::core::restore::init::<ConstraintsActive>(world);
         // The whole-step path integrates rigid bodies only, with constant forces.
-        crate::whole_step::block_on::<ExternalImpulse>(world);
-        crate::whole_step::block_on::<ExternalImpulseAtPoint>(world);
-        crate::whole_step::block_on::<IntegratorOverride>(world);
-        crate::whole_step::block_on::<Nodes>(world);
+        crate::core::whole_step::block_on::<ExternalImpulse>(world);
+        crate::core::whole_step::block_on::<ExternalImpulseAtPoint>(world);
+        crate::core::whole_step::block_on::<IntegratorOverride>(world);
+        crate::core::whole_step::block_on::<Nodes>(world);
+        crate::core::plugin::moves::<Mass>(world);
+        crate::core::plugin::moves::<Nodes>(world);
+        crate::core::plugin::moves::<Tracer>(world);
+        add_own_systems(
+            world,
+            PhysicsSchedule,
+            quarantine_runaway_velocities.in_set(PrepareSystems::Guard),
+        );
         add_own_force_systems(world, || clear_forces.in_set(StepSystems::ClearForces));
         add_own_systems(
             world,
@@ -68,7 +81,7 @@ impl WorldPlugin for IntegratorPlugin {
 }
 
 /// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
+type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 /// Initialises every accumulator with the body's constant forces, f ← f_ext + m g s, and
 /// every torque accumulator with its constant torque, τ ← τ_ext.
@@ -410,6 +423,26 @@ fn integrate_positions(
         }
         if probe != Vec3A::ZERO {
             check_mesh(&mut commands, e, n, &guard);
+        }
+    }
+}
+
+/// A velocity past the guard (game code set a crate to 1e30 m/s) is caught before the step
+/// uses it: the contacts run before the integrators' own check, and a runaway's sweep box
+/// covers the world, so in that one step it flung bodies 30 m away to 1e27 m (found by the
+/// scenario corpus, `scenarios/quarantine_caught.ron`). One compare per moved body.
+fn quarantine_runaway_velocities(
+    mut commands: Commands,
+    guard: Option<Res<DivergenceGuard>>,
+    moved: Query<
+        (Entity, &Position, &LinearVelocity),
+        (Changed<LinearVelocity>, Without<Quarantined>),
+    >,
+) {
+    let guard = guard.map_or_else(DivergenceGuard::default, |g| *g);
+    for (e, x, v) in &moved {
+        if let Some(reason) = guard.check(x.0, v.0, None) {
+            commands.entity(e).try_insert(Quarantined { reason });
         }
     }
 }

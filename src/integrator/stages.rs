@@ -14,14 +14,14 @@ use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3A};
 
 use super::{Integrator, IntegratorOverride, kick};
+use crate::core::quarantine::{QuarantineReason, Quarantined};
+use crate::core::schedule::ForceSchedule;
+use crate::core::time::SubstepTime;
 use crate::particles::{Force, LinearVelocity, Mass, Nodes, Position};
-use crate::quarantine::{QuarantineReason, Quarantined};
 use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, Rotation, Torque, quat_derivative};
-use crate::schedule::ForceSchedule;
-use crate::time::SubstepTime;
 
 /// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
+type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 const WEIGHT: [f32; 4] = [1.0, 2.0, 2.0, 1.0];
 const OFFSET: [f32; 3] = [0.5, 0.5, 1.0];
@@ -283,7 +283,7 @@ pub(crate) fn complete_stages(
     // RK4 bodies skipped the position phase, so check them here (non-finite, or faster than
     // the divergence guard allows).
     let guard = world
-        .get_resource::<crate::quarantine::DivergenceGuard>()
+        .get_resource::<crate::core::quarantine::DivergenceGuard>()
         .copied()
         .unwrap_or_default();
     let mut bad = Vec::new();

@@ -1,9 +1,9 @@
 //! Uniform gravity and velocity fields.
 //!
 //! **Gravity** is a resource g (m/s²); each body feels f = m g s, with s its
-//! [`crate::GravityScale`] (1 by default).
+//! [`crate::particles::GravityScale`] (1 by default).
 //!
-//! **Velocity fields** carry massless [`crate::Tracer`]s: dx/dt = Σ u_k(x, t), summed over
+//! **Velocity fields** carry massless [`crate::particles::Tracer`]s: dx/dt = Σ u_k(x, t), summed over
 //! every [`VelocityField`] entity. The lecture's update is Euler, x ← x + h u(x, t); the
 //! [`Advection`] resource picks a higher-order scheme. For the vortex u = ω × (x − c) Euler
 //! multiplies the distance to the axis by √(1 + (|ω|h)²) every step (tracers spiral out),
@@ -15,7 +15,7 @@ use std::sync::Arc;
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 
-use crate::error::{Result, finite, finite_vec};
+use crate::core::error::{Result, finite, finite_vec};
 
 /// Uniform gravitational acceleration (m/s²). Default: (0, −9.81, 0).
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]

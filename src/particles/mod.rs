@@ -28,8 +28,8 @@ pub use plugin::{DampingPlugin, GravityPlugin, VelocityFieldPlugin};
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 
-use crate::error::{Error, Result, finite, finite_vec, non_negative};
-use crate::quarantine::{Validate, validate_on_insert};
+use crate::core::error::{Error, Result, finite, finite_vec, non_negative};
+use crate::core::quarantine::{Validate, validate_on_insert};
 
 macro_rules! finite_vec_component {
     ($(#[$doc:meta])* $name:ident($ty:ty), $what:literal) => {
@@ -134,17 +134,17 @@ fn quarantine_massless(
         if optional
             || e.contains::<Mass>()
             || e.contains::<Tracer>()
-            || e.contains::<crate::quarantine::Quarantined>()
+            || e.contains::<crate::core::quarantine::Quarantined>()
             || !e.contains::<LinearVelocity>()
         {
             return;
         }
         world
             .entity_mut(entity)
-            .insert(crate::quarantine::Quarantined {
-                reason: crate::quarantine::QuarantineReason::InvalidInput(Error::ComponentRemoved(
-                    "Mass",
-                )),
+            .insert(crate::core::quarantine::Quarantined {
+                reason: crate::core::quarantine::QuarantineReason::InvalidInput(
+                    Error::ComponentRemoved("Mass"),
+                ),
             });
     });
 }

@@ -3,7 +3,7 @@
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 
-use crate::error::{Error, Result, finite_vec};
+use crate::core::error::{Error, Result, finite_vec};
 
 /// Many particles in one component, stored as parallel arrays so that force and integration
 /// loops stream through memory. Gravity, damping, every integrator and the NaN quarantine act
@@ -16,7 +16,7 @@ pub struct Nodes {
     pub(crate) x: Vec<Vec3A>,
     pub(crate) v: Vec<Vec3A>,
     pub(crate) f: Vec<Vec3A>,
-    /// m, or 0 for pinned nodes (as in [`crate::Mass`]).
+    /// m, or 0 for pinned nodes (as in [`crate::particles::Mass`]).
     pub(crate) mass: Vec<f32>,
     pub(crate) inv_mass: Vec<f32>,
 }
@@ -59,7 +59,7 @@ impl Nodes {
     /// # Errors
     /// [`Error::NonFinite`] or [`Error::InvalidMass`].
     pub fn push(&mut self, x: Vec3, v: Vec3, kg: f32) -> Result<usize> {
-        let m = crate::Mass::new(kg)?;
+        let m = crate::particles::Mass::new(kg)?;
         self.push_raw(
             finite_vec("node position", x)?,
             finite_vec("node velocity", v)?,
@@ -75,11 +75,11 @@ impl Nodes {
         self.push_raw(
             finite_vec("node position", x)?,
             Vec3::ZERO,
-            crate::Mass::PINNED,
+            crate::particles::Mass::PINNED,
         )
     }
 
-    fn push_raw(&mut self, x: Vec3, v: Vec3, m: crate::Mass) -> Result<usize> {
+    fn push_raw(&mut self, x: Vec3, v: Vec3, m: crate::particles::Mass) -> Result<usize> {
         self.x.push(x.into());
         self.v.push(v.into());
         self.f.push(Vec3A::ZERO);
@@ -118,7 +118,7 @@ impl Nodes {
     /// [`Error::IndexOutOfRange`] or [`Error::InvalidMass`].
     pub fn set_mass(&mut self, i: usize, kg: f32) -> Result<()> {
         self.check(i)?;
-        let m = crate::Mass::new(kg)?;
+        let m = crate::particles::Mass::new(kg)?;
         self.mass[i] = m.force_scale();
         self.inv_mass[i] = m.inverse();
         Ok(())
@@ -145,7 +145,7 @@ impl Nodes {
     }
 
     /// Adds `f` (N) to node `i`'s force accumulator, for a force system placed in
-    /// [`crate::ForceSystems::User`] (a point load, a grab). The accumulator is reset every
+    /// [`crate::core::schedule::ForceSystems::User`] (a point load, a grab). The accumulator is reset every
     /// evaluation, so the force acts only while the system keeps adding it.
     ///
     /// # Errors

@@ -5,28 +5,28 @@ use glam::Vec3A;
 
 use super::fields::{Advection, Gravity, VelocityField};
 use super::{Force, LinearDamping, LinearVelocity, Mass, Position, Tracer};
-use crate::WorldPlugin;
-use crate::integrator::{advect_euler, advect_midpoint, advect_rk4};
-use crate::quarantine::{Quarantined, quarantine_non_finite};
-use crate::schedule::{
+use crate::core::plugin::WorldPlugin;
+use crate::core::quarantine::{Quarantined, quarantine_non_finite};
+use crate::core::schedule::{
     ForceSystems, StepSystems, SubstepSchedule, add_own_force_systems, add_own_systems,
 };
-use crate::time::SubstepTime;
+use crate::core::time::SubstepTime;
+use crate::integrator::{advect_euler, advect_midpoint, advect_rk4};
 
 /// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
+type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 /// Uniform gravity, f = m g s: installs the [`Gravity`] resource. Gravity is a constant
 /// force, so the core's force-clearing pass writes it into each accumulator (see
-/// [`crate::schedule::StepSystems::ClearForces`]); this plugin adds no system, and a world
+/// [`crate::core::schedule::StepSystems::ClearForces`]); this plugin adds no system, and a world
 /// without it has no gravity at all.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct GravityPlugin;
 
 impl WorldPlugin for GravityPlugin {
     fn build(&self, world: &mut World) {
-        crate::restore::init::<Gravity>(world);
-        crate::quarantine::validate_writes::<super::GravityScale>(world);
+        crate::core::restore::init::<Gravity>(world);
+        crate::core::quarantine::validate_writes::<super::GravityScale>(world);
     }
 }
 
@@ -36,7 +36,7 @@ pub struct DampingPlugin;
 
 impl WorldPlugin for DampingPlugin {
     fn build(&self, world: &mut World) {
-        crate::whole_step::block_on::<LinearDamping>(world);
+        crate::core::whole_step::block_on::<LinearDamping>(world);
         add_own_force_systems(world, || {
             apply_damping
                 .run_if(any_with_component::<LinearDamping>)
@@ -57,8 +57,8 @@ pub struct VelocityFieldPlugin;
 
 impl WorldPlugin for VelocityFieldPlugin {
     fn build(&self, world: &mut World) {
-        crate::restore::init::<Advection>(world);
-        crate::whole_step::block_on::<Tracer>(world);
+        crate::core::restore::init::<Advection>(world);
+        crate::core::whole_step::block_on::<Tracer>(world);
         add_own_systems(
             world,
             SubstepSchedule,

@@ -13,7 +13,7 @@ use glam::{Mat3, Quat, Vec3};
 use parry3d::shape::Shape;
 
 use super::{AngularVelocity, CenterOfMass, Inertia, RigidBody, Rotation, check_density};
-use crate::error::{Error, Result, finite_vec};
+use crate::core::error::{Error, Result, finite_vec};
 use crate::particles::{LinearVelocity, Mass, Position};
 
 /// The inertia tensor about a point displaced by `d` (m) from the centre of mass:

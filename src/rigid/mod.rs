@@ -1,7 +1,7 @@
 //! Rigid bodies: the lecture's state (x, R, P, L).
 //!
-//! A rigid body is a particle ([`crate::Position`] = centre of mass x, [`crate::LinearVelocity`]
-//! v = P/M, [`crate::Mass`], [`crate::Force`]) plus an orientation and angular momentum:
+//! A rigid body is a particle ([`crate::particles::Position`] = centre of mass x, [`crate::particles::LinearVelocity`]
+//! v = P/M, [`crate::particles::Mass`], [`crate::particles::Force`]) plus an orientation and angular momentum:
 //!
 //! ```text
 //! dx/dt = v          dP/dt = f
@@ -16,7 +16,7 @@
 //!   Writing [`AngularMomentum`] instead sets ω = I⁻¹ L. hooke itself updates both without
 //!   change ticks, so `Changed<AngularVelocity>` means "a user wrote it".
 //! - [`Inertia`] holds I₀ by its principal moments and principal frame, and their inverse.
-//! - [`Torque`] τ (N·m) accumulates like [`crate::Force`]: cleared to [`ExternalTorque`], then
+//! - [`Torque`] τ (N·m) accumulates like [`crate::particles::Force`]: cleared to [`ExternalTorque`], then
 //!   springs at anchors and [`ExternalForceAtPoint`]s add r × f.
 //! - [`CenterOfMass`] is the centre of mass in the shape's frame: the body's frame origin is
 //!   x − R c.
@@ -30,7 +30,7 @@
 //! bounded. A body with three equal moments (a sphere, a cube) has constant ω = L/I, and the
 //! splitting takes the exact single turn exp(½ h ω) for it. RK4 integrates q as a 4-vector
 //! with the derivative ½ ω ⊗ q at each stage. The
-//! [`StepSystems::Renormalize`](crate::StepSystems::Renormalize) set renormalises q every
+//! [`StepSystems::Renormalize`](crate::core::schedule::StepSystems::Renormalize) set renormalises q every
 //! substep unless [`Renormalization`] is off (to show its effect) or a body has
 //! [`SkipRenormalization`].
 //!
@@ -50,16 +50,16 @@ pub(crate) use plugin::turn;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3, Vec3A};
 
-use crate::error::{Error, Result, finite, finite_vec, non_negative};
+use crate::core::error::{Error, Result, finite, finite_vec, non_negative};
+use crate::core::quarantine::{Validate, validate_on_insert};
 use crate::particles::Position;
-use crate::quarantine::{Validate, validate_on_insert};
 
 /// How a rigid body moves.
 ///
 /// Spawn a body the way Bevy spawns anything, with required components:
 /// `(RigidBody::Dynamic, Collider::cuboid(0.5, 0.5, 0.5)?, Position(..))` is a dynamic body
 /// whose mass, centre of mass and inertia come from its colliders and their
-/// [`crate::ColliderDensity`] (1000 kg/m³ by default), unless you give a [`crate::Mass`] (or
+/// [`crate::collision::ColliderDensity`] (1000 kg/m³ by default), unless you give a [`crate::particles::Mass`] (or
 /// use [`RigidBodyBundle`]). Inserting another kind later changes the body: kinematic
 /// bodies get infinite mass and inertia, static bodies lose their mass and velocity
 /// components.
@@ -169,7 +169,7 @@ angular_vec!(
     "external torque"
 );
 
-/// The torque accumulator τ (N·m, world frame), like [`crate::Force`].
+/// The torque accumulator τ (N·m, world frame), like [`crate::particles::Force`].
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
@@ -409,7 +409,7 @@ impl Validate for ExternalForceAtPoint {
 }
 
 /// A one-shot impulse J (N·s, world frame) at a point: Δv = J/m, ΔL = (p − x) × J at the
-/// next substep, then the impulse is reset to zero (like [`crate::ExternalImpulse`]).
+/// next substep, then the impulse is reset to zero (like [`crate::particles::ExternalImpulse`]).
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct ExternalImpulseAtPoint {

@@ -8,18 +8,18 @@ use super::{
     KinematicTarget, OrientationUpdate, Renormalization, Rotation, SkipRenormalization, Torque,
     free_rotation_split, integrate_rotation, omega_of, world_point,
 };
-use crate::WorldPlugin;
-use crate::integrator::{Integrator, IntegratorOverride};
-use crate::particles::{Force, LinearVelocity, Position};
-use crate::quarantine::{Quarantined, quarantine_non_finite};
-use crate::schedule::{
+use crate::core::plugin::WorldPlugin;
+use crate::core::quarantine::{Quarantined, quarantine_non_finite};
+use crate::core::schedule::{
     ForceSystems, IntegrationSystems, PhysicsSchedule, PrepareSystems, StepSystems,
     SubstepSchedule, add_own_force_systems, add_own_systems,
 };
-use crate::time::{PhysicsTime, SubstepTime};
+use crate::core::time::{PhysicsTime, SubstepTime};
+use crate::integrator::{Integrator, IntegratorOverride};
+use crate::particles::{Force, LinearVelocity, Position};
 
 /// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
+type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 /// Rotation, angular momentum, torque and renormalisation for bodies with [`Inertia`]. Every
 /// system runs only while such a body exists (or, for the optional inputs, while one has
@@ -33,13 +33,13 @@ impl WorldPlugin for RigidBodyPlugin {
             .get_resource_or_init::<crate::particles::MassOptional>()
             .0
             .push(|e| e.get::<super::RigidBody>() == Some(&super::RigidBody::Static));
-        crate::restore::init::<OrientationUpdate>(world);
-        crate::quarantine::validate_writes::<super::AngularDamping>(world);
-        crate::quarantine::validate_writes::<super::KinematicTarget>(world);
-        crate::restore::init::<Renormalization>(world);
-        crate::whole_step::block_on::<AngularDamping>(world);
-        crate::whole_step::block_on::<ExternalForceAtPoint>(world);
-        crate::whole_step::block_on::<SkipRenormalization>(world);
+        crate::core::restore::init::<OrientationUpdate>(world);
+        crate::core::quarantine::validate_writes::<super::AngularDamping>(world);
+        crate::core::quarantine::validate_writes::<super::KinematicTarget>(world);
+        crate::core::restore::init::<Renormalization>(world);
+        crate::core::whole_step::block_on::<AngularDamping>(world);
+        crate::core::whole_step::block_on::<ExternalForceAtPoint>(world);
+        crate::core::whole_step::block_on::<SkipRenormalization>(world);
         add_own_systems(
             world,
             PhysicsSchedule,
@@ -227,7 +227,7 @@ fn integrate_orientations(
     global: Res<Integrator>,
     update: Res<OrientationUpdate>,
     time: Res<SubstepTime>,
-    guard: Res<crate::quarantine::DivergenceGuard>,
+    guard: Res<crate::core::quarantine::DivergenceGuard>,
     mut bodies: Query<OrientationState, Live>,
 ) {
     let h = time.h;
@@ -246,7 +246,7 @@ fn integrate_orientations(
             quarantine_non_finite(&mut commands, e);
         } else if w.0.length_squared() > spin_limit {
             commands.entity(e).insert(Quarantined {
-                reason: crate::quarantine::QuarantineReason::SpunOut {
+                reason: crate::core::quarantine::QuarantineReason::SpunOut {
                     angular_speed: w.0.length(),
                 },
             });

@@ -8,10 +8,14 @@ use super::Expectation;
 use super::format::{Check, Quantity};
 use super::report::Outcome;
 use super::run::{Names, group, momentum};
-use crate::{
-    AngularVelocity, Contacts, LinearVelocity, Nodes, PhysicsDiagnostics, Position, Quarantined,
-    Sleeping,
-};
+use crate::collision::Contacts;
+use crate::core::diagnostics::PhysicsDiagnostics;
+use crate::core::quarantine::Quarantined;
+use crate::core::rest::Sleeping;
+use crate::particles::LinearVelocity;
+use crate::particles::Nodes;
+use crate::particles::Position;
+use crate::rigid::AngularVelocity;
 
 /// Position, velocity and angular velocity of one entity (m, m/s, rad/s), in f64.
 #[derive(Debug, Clone, Copy, Default)]

@@ -7,7 +7,8 @@
 use glam::Vec3;
 use serde::Deserialize;
 
-use crate::{Advection, Integrator};
+use crate::integrator::Integrator;
+use crate::particles::Advection;
 
 /// `settings: (..)`: the world. Every field has a default.
 #[derive(Deserialize, Debug, Clone, PartialEq)]
@@ -46,19 +47,19 @@ impl Default for Settings {
 /// An effect plugin, by name.
 #[derive(Deserialize, Debug, Clone, Copy, PartialEq, Eq)]
 pub enum PluginName {
-    /// [`crate::GravityPlugin`].
+    /// [`crate::particles::GravityPlugin`].
     Gravity,
-    /// [`crate::DampingPlugin`].
+    /// [`crate::particles::DampingPlugin`].
     Damping,
-    /// [`crate::VelocityFieldPlugin`].
+    /// [`crate::particles::VelocityFieldPlugin`].
     VelocityField,
-    /// [`crate::SpringPlugin`].
+    /// [`crate::springs::SpringPlugin`].
     Springs,
-    /// [`crate::RigidBodyPlugin`].
+    /// [`crate::rigid::RigidBodyPlugin`].
     RigidBody,
-    /// [`crate::CollisionPlugin`].
+    /// [`crate::collision::CollisionPlugin`].
     Collision,
-    /// [`crate::SleepPlugin`].
+    /// [`crate::sleep::SleepPlugin`].
     Sleep,
     /// [`crate::soft::SoftBodyPlugin`].
     SoftBody,

@@ -177,6 +177,9 @@ pub enum ScenarioErrorKind {
     /// A constructor refused a value while the scene was built or an action ran.
     #[error("{0}")]
     Build(crate::Error),
+    /// The final state could not be captured for its hash.
+    #[error("{0}")]
+    Snapshot(crate::snapshot::SnapshotError),
 }
 
 impl Scenario {

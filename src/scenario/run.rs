@@ -12,12 +12,24 @@ use super::check::{Kin, Moment, Probe, Track, evaluate, finish};
 use super::format::{Action, PluginName};
 use super::report::{Outcome, Report, Trace};
 use super::{Scenario, ScenarioError, ScenarioErrorKind, Selector, spawn};
-use crate::error::{Error, finite_vec};
-use crate::{
-    AngularVelocity, BodyQuarantined, ExternalForce, ExternalImpulse, ExternalTorque, Friction,
-    Gravity, LinearVelocity, Mass, Nodes, PhysicsPlugins, PhysicsTime, PhysicsWorldExt, Position,
-    Restitution, RigidBody, SleepSettings,
-};
+use crate::PhysicsPlugins;
+use crate::PhysicsWorldExt;
+use crate::collision::Friction;
+use crate::collision::Restitution;
+use crate::core::error::{Error, finite_vec};
+use crate::core::quarantine::BodyQuarantined;
+use crate::core::time::PhysicsTime;
+use crate::particles::ExternalForce;
+use crate::particles::ExternalImpulse;
+use crate::particles::Gravity;
+use crate::particles::LinearVelocity;
+use crate::particles::Mass;
+use crate::particles::Nodes;
+use crate::particles::Position;
+use crate::rigid::AngularVelocity;
+use crate::rigid::ExternalTorque;
+use crate::rigid::RigidBody;
+use crate::sleep::SleepSettings;
 
 /// How to run: traces and progress.
 #[derive(Default)]
@@ -62,13 +74,13 @@ pub(super) fn group<'a>(names: &'a Names, text: &str) -> &'a [Entity] {
 
 fn add_plugin(world: &mut World, p: PluginName) {
     match p {
-        PluginName::Gravity => world.add_physics(crate::GravityPlugin),
-        PluginName::Damping => world.add_physics(crate::DampingPlugin),
-        PluginName::VelocityField => world.add_physics(crate::VelocityFieldPlugin),
-        PluginName::Springs => world.add_physics(crate::SpringPlugin),
-        PluginName::RigidBody => world.add_physics(crate::RigidBodyPlugin),
-        PluginName::Collision => world.add_physics(crate::CollisionPlugin),
-        PluginName::Sleep => world.add_physics(crate::SleepPlugin),
+        PluginName::Gravity => world.add_physics(crate::particles::GravityPlugin),
+        PluginName::Damping => world.add_physics(crate::particles::DampingPlugin),
+        PluginName::VelocityField => world.add_physics(crate::particles::VelocityFieldPlugin),
+        PluginName::Springs => world.add_physics(crate::springs::SpringPlugin),
+        PluginName::RigidBody => world.add_physics(crate::rigid::RigidBodyPlugin),
+        PluginName::Collision => world.add_physics(crate::collision::CollisionPlugin),
+        PluginName::Sleep => world.add_physics(crate::sleep::SleepPlugin),
         PluginName::SoftBody => world.add_physics(crate::soft::SoftBodyPlugin),
         PluginName::Cloth => world.add_physics(crate::cloth::ClothPlugin),
     };
@@ -218,7 +230,7 @@ pub(super) fn run(s: &Scenario, options: &mut RunOptions) -> Result<Report, Scen
         .collect();
     let hash = crate::snapshot::Snapshot::capture(&world)
         .map(|snap| snap.digest())
-        .map_err(|e| s.error(s.hash_line, ScenarioErrorKind::Build(e)))?;
+        .map_err(|e| s.error(s.hash_line, ScenarioErrorKind::Snapshot(e)))?;
     if let Some(expected) = s.hash {
         outcomes.push(Outcome {
             line: s.hash_line,
@@ -434,11 +446,11 @@ fn act(
                     }
                     if !on {
                         let sleepers: Vec<Entity> = world
-                            .query_filtered::<Entity, With<crate::Sleeping>>()
+                            .query_filtered::<Entity, With<crate::core::rest::Sleeping>>()
                             .iter(world)
                             .collect();
                         for e in sleepers {
-                            world.entity_mut(e).remove::<crate::Sleeping>();
+                            world.entity_mut(e).remove::<crate::core::rest::Sleeping>();
                         }
                     }
                 }

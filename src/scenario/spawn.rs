@@ -5,13 +5,27 @@ use bevy_ecs::prelude::*;
 use glam::{EulerRot, Quat};
 
 use super::format::{BodyKind, Field, Shape, Spawn};
-use crate::error::{Error, Result, finite, finite_vec, non_negative};
-use crate::quarantine::Validate;
-use crate::{
-    AngularVelocity, ChainBuilder, ClothBuilder, Collider, ColliderDensity, Friction,
-    LinearDamping, LinearVelocity, Mass, ParticleBundle, Position, Restitution,
-    RestitutionThreshold, RigidBody, Rotation, Spring, Tracer, VelocityField, scenes,
-};
+use crate::cloth::ClothBuilder;
+use crate::collision::Collider;
+use crate::collision::ColliderDensity;
+use crate::collision::Friction;
+use crate::collision::Restitution;
+use crate::collision::RestitutionThreshold;
+use crate::core::error::{Error, Result, finite, finite_vec, non_negative};
+use crate::core::quarantine::Validate;
+use crate::particles::LinearDamping;
+use crate::particles::LinearVelocity;
+use crate::particles::Mass;
+use crate::particles::ParticleBundle;
+use crate::particles::Position;
+use crate::particles::Tracer;
+use crate::particles::VelocityField;
+use crate::rigid::AngularVelocity;
+use crate::rigid::RigidBody;
+use crate::rigid::Rotation;
+use crate::scenes;
+use crate::springs::ChainBuilder;
+use crate::springs::Spring;
 
 /// Spawns `spawn`; `lookup` resolves the names a spring's ends use to one entity.
 pub(super) fn spawn(
@@ -181,7 +195,7 @@ pub(super) fn spawn(
                 b = b.damping(*c);
             }
             let cloth = b.spawn(world)?;
-            if let Some(mut nodes) = world.get_mut::<crate::Nodes>(cloth) {
+            if let Some(mut nodes) = world.get_mut::<crate::particles::Nodes>(cloth) {
                 for &i in pin {
                     nodes.pin(i)?;
                 }

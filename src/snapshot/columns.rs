@@ -9,8 +9,8 @@ use bevy_platform::collections::HashMap;
 use serde::{Deserialize, Serialize};
 
 use super::SnapshotError;
-use crate::error::Error;
-use crate::quarantine::Validate;
+use crate::core::error::Error;
+use crate::core::quarantine::Validate;
 
 /// What a snapshot does with each component type beyond storing it: check a value read
 /// back (a file may be edited by hand), and map the entities it names onto the restored
@@ -68,13 +68,53 @@ macro_rules! validated {
 }
 
 use crate::cloth::Cloth;
+use crate::collision::Collider;
 use crate::collision::ColliderAabb;
+use crate::collision::ColliderDensity;
+use crate::collision::ColliderOf;
+use crate::collision::ColliderOffset;
+use crate::collision::CollisionEventsEnabled;
+use crate::collision::CollisionLayers;
+use crate::collision::Friction;
+use crate::collision::Restitution;
+use crate::collision::RestitutionThreshold;
+use crate::collision::Sensor;
 use crate::collision::{NodeImpulse, OwnShape};
+use crate::core::quarantine::Quarantined;
+use crate::core::rest::{SleepTimer, Sleeping, SleepingDisabled};
 use crate::integrator::ImplicitByDial;
-use crate::rest::{SleepTimer, Sleeping, SleepingDisabled};
+use crate::integrator::ImplicitEuler;
+use crate::integrator::ImplicitState;
+use crate::integrator::IntegratorOverride;
+use crate::particles::ExternalForce;
+use crate::particles::ExternalImpulse;
+use crate::particles::Force;
+use crate::particles::GravityScale;
+use crate::particles::LinearDamping;
+use crate::particles::LinearVelocity;
+use crate::particles::Mass;
+use crate::particles::Nodes;
+use crate::particles::Position;
+use crate::particles::Tracer;
+use crate::particles::VelocityField;
+use crate::rigid::AngularDamping;
+use crate::rigid::AngularMomentum;
+use crate::rigid::AngularVelocity;
+use crate::rigid::CenterOfMass;
 use crate::rigid::ComputedMass;
+use crate::rigid::ExternalForceAtPoint;
+use crate::rigid::ExternalImpulseAtPoint;
+use crate::rigid::ExternalTorque;
+use crate::rigid::Inertia;
+use crate::rigid::KinematicTarget;
+use crate::rigid::RigidBody;
+use crate::rigid::Rotation;
+use crate::rigid::SkipRenormalization;
+use crate::rigid::Torque;
 use crate::soft::{NodeAttachments, NodeTargets, SoftBody};
-use crate::*;
+use crate::springs::Spring;
+use crate::springs::SpringNetwork;
+use crate::springs::SpringStability;
 use core::result::Result;
 
 validated!(

@@ -40,14 +40,14 @@
 //! keeps a grown box while the collider stays inside it, so its candidate pairs depend on
 //! history; the fixed colliders' tree is rebuilt, their pairs do not).
 //! Not stored: game components, Bevy's `Transform` (re-derived from the pose), messages in
-//! flight, and [`crate::VelocityField::Custom`] (a closure: [`Snapshot::capture`] refuses it).
+//! flight, and [`crate::particles::VelocityField::Custom`] (a closure: [`Snapshot::capture`] refuses it).
 //!
 //! **Formats.** [`Snapshot::to_bytes`]: `HOOKESNP`, the format version (u32, little end),
 //! the payload length (u64), its CRC-32, then the payload in postcard (compact: varints,
 //! no field names). [`Snapshot::to_ron`]: the same state as readable RON, for bug reports
 //! and debugging. Reading either checks what it can — magic, version, checksum, every value
 //! through the same checks as its constructor, indices into meshes, entities named — and
-//! returns a [`SnapshotError`] (inside [`Error::Snapshot`]) rather than panicking.
+//! returns a [`SnapshotError`] rather than panicking.
 //!
 //! **Entities.** [`Snapshot::restore`] spawns new entities into any world with the physics
 //! plugins and returns the [`EntityMap`] from the captured ids to the new ones. New ids keep
@@ -63,10 +63,24 @@ use bevy_ecs::prelude::*;
 use bevy_platform::collections::HashMap;
 use serde::{Deserialize, Serialize};
 
+use crate::collision::ColliderChanges;
+use crate::collision::ContactSettings;
+use crate::collision::Contacts;
 use crate::collision::ContactsRecord;
-use crate::error::Error;
-use crate::error::Result;
-use crate::*;
+use crate::core::diagnostics::DiagnosticsSettings;
+use crate::core::error::Result;
+use crate::core::quarantine::DivergenceGuard;
+use crate::core::time::PhysicsTime;
+use crate::core::time::SubstepTime;
+use crate::integrator::ConstraintsActive;
+use crate::integrator::Integrator;
+use crate::particles::Advection;
+use crate::particles::Gravity;
+use crate::rigid::OrientationUpdate;
+use crate::rigid::Renormalization;
+use crate::sleep::SleepSettings;
+use crate::springs::EntitySpringStability;
+use crate::springs::StabilityPolicy;
 use columns::Columns;
 
 /// The version [`Snapshot::to_bytes`] writes and [`Snapshot::from_bytes`] reads. It changes
@@ -154,8 +168,8 @@ pub enum SnapshotError {
     NoPlugins,
 }
 
-fn fail<T>(e: SnapshotError) -> Result<T> {
-    Err(Error::Snapshot(e))
+fn fail<T>(e: SnapshotError) -> Result<T, SnapshotError> {
+    Err(e)
 }
 
 /// The settings and clock resources, each if the world had it.
@@ -273,7 +287,7 @@ impl Snapshot {
     ///
     /// # Errors
     /// [`SnapshotError::Unsupported`] for a [`VelocityField::Custom`] (a closure).
-    pub fn capture(world: &World) -> Result<Self> {
+    pub fn capture(world: &World) -> Result<Self, SnapshotError> {
         let ids = Columns::component_ids(world);
         // Storage order: table by table, row by row, as a query walks them.
         let mut entities = Vec::new();
@@ -332,7 +346,7 @@ impl Snapshot {
     /// # Errors
     /// [`SnapshotError::NoPlugins`], [`SnapshotError::DuplicateEntity`], and the value checks
     /// ([`SnapshotError::Invalid`], [`SnapshotError::BadSlot`], [`SnapshotError::Dangling`]).
-    pub fn restore(&self, world: &mut World) -> Result<EntityMap> {
+    pub fn restore(&self, world: &mut World) -> Result<EntityMap, SnapshotError> {
         if !world.contains_resource::<PhysicsTime>() {
             return fail(SnapshotError::NoPlugins);
         }
@@ -418,7 +432,7 @@ impl Snapshot {
     /// give the same digest, so a pinned digest shows when a change alters results. Entities
     /// are counted by their place in storage order, not by id: a plugin that adds a
     /// resource (and so shifts every entity id after it) leaves digests as they were. The
-    /// entities a [`crate::QuarantineReason`] names are the exception (kept as ids).
+    /// entities a [`crate::core::quarantine::QuarantineReason`] names are the exception (kept as ids).
     #[must_use]
     pub fn digest(&self) -> u64 {
         let mut canonical = self.clone();
@@ -475,7 +489,7 @@ impl Snapshot {
     /// # Errors
     /// [`SnapshotError::NotASnapshot`], [`SnapshotError::Version`],
     /// [`SnapshotError::Truncated`], [`SnapshotError::Checksum`], [`SnapshotError::Decode`].
-    pub fn from_bytes(bytes: &[u8]) -> Result<Self> {
+    pub fn from_bytes(bytes: &[u8]) -> Result<Self, SnapshotError> {
         if bytes.len() < 8 || bytes[..8] != MAGIC {
             return fail(SnapshotError::NotASnapshot);
         }
@@ -513,28 +527,27 @@ impl Snapshot {
                 expected: crc,
             });
         }
-        postcard::from_bytes(payload)
-            .map_err(|e| Error::Snapshot(SnapshotError::Decode(e.to_string())))
+        postcard::from_bytes(payload).map_err(|e| SnapshotError::Decode(e.to_string()))
     }
 
     /// The readable form: RON, one field per line.
     ///
     /// # Errors
     /// [`SnapshotError::Decode`] if a value cannot be written as RON.
-    pub fn to_ron(&self) -> Result<String> {
+    pub fn to_ron(&self) -> Result<String, SnapshotError> {
         let versioned = Versioned {
             version: FORMAT_VERSION,
             snapshot: self.clone(),
         };
         ron::ser::to_string_pretty(&versioned, ron::ser::PrettyConfig::default())
-            .map_err(|e| Error::Snapshot(SnapshotError::Decode(e.to_string())))
+            .map_err(|e| SnapshotError::Decode(e.to_string()))
     }
 
     /// Reads [`Snapshot::to_ron`]'s form.
     ///
     /// # Errors
     /// [`SnapshotError::Version`], or [`SnapshotError::Decode`] with the line and column.
-    pub fn from_ron(text: &str) -> Result<Self> {
+    pub fn from_ron(text: &str) -> Result<Self, SnapshotError> {
         // The version first, so that another version's layout reads as a version error.
         let options = ron::Options::default();
         if let Ok(h) = options.from_str::<HeaderOnly>(text)
@@ -548,7 +561,7 @@ impl Snapshot {
         options
             .from_str::<Versioned>(text)
             .map(|v| v.snapshot)
-            .map_err(|e| Error::Snapshot(SnapshotError::Decode(e.to_string())))
+            .map_err(|e| SnapshotError::Decode(e.to_string()))
     }
 }
 

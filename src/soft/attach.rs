@@ -34,12 +34,12 @@ use nalgebra::{DMatrix, DVector};
 use crate::collision::coupling::{RigidSide, move_soft, soft_response};
 use crate::integrator::skyline::SkylineCholesky;
 
-use crate::error::{Error, Result};
+use crate::core::error::{Error, Result};
+use crate::core::quarantine::Quarantined;
+use crate::core::time::SubstepTime;
 use crate::integrator::{ImplicitEuler, ImplicitState};
 use crate::particles::{LinearVelocity, Mass, Nodes, Position};
-use crate::quarantine::Quarantined;
 use crate::rigid::{AngularMomentum, AngularVelocity, CenterOfMass, Inertia, Rotation};
-use crate::time::SubstepTime;
 
 /// The most nodes one attachment holds: its constraint is solved as one dense 3n × 3n system.
 pub const MAX_ATTACHED_NODES: usize = 128;
@@ -74,7 +74,7 @@ impl NodeAttachments {
     }
 
     /// Whether every link indexes into a mesh of `nodes` nodes and has a local point per
-    /// node once set (see [`crate::Nodes`]).
+    /// node once set (see [`crate::particles::Nodes`]).
     pub(crate) fn fits(&self, nodes: usize) -> bool {
         self.links.iter().all(|l| {
             l.nodes.iter().all(|&i| (i as usize) < nodes)

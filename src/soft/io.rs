@@ -10,7 +10,7 @@ use std::path::Path;
 use glam::Vec3;
 
 use super::TetMesh;
-use crate::error::{Error, Result};
+use crate::core::error::{Error, Result};
 
 /// The non-empty, non-comment lines of a file, with their 1-based numbers.
 struct Lines<'a> {

@@ -2,7 +2,7 @@
 
 use glam::{Mat3, Vec3};
 
-use crate::error::{Error, Result, finite_vec, positive};
+use crate::core::error::{Error, Result, finite_vec, positive};
 
 /// How a hexahedral cell is cut into tetrahedra.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

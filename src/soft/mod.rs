@@ -2,7 +2,7 @@
 //!
 //! A [`SoftBody`] is one entity per tetrahedral mesh ([`TetMesh`]): its nodes are a
 //! [`Nodes`] component, its elements live in the [`SoftBody`] component, and
-//! [`SoftBodyPlugin`] adds their elastic forces in [`crate::ForceSystems::Elasticity`], so
+//! [`SoftBodyPlugin`] adds their elastic forces in [`crate::core::schedule::ForceSystems::Elasticity`], so
 //! every integrator of the dial advances it. The material math is pure functions of the
 //! deformation gradient ([`strain`]), tested against closed forms.
 //!
@@ -47,7 +47,7 @@ pub use targets::NodeTargets;
 use bevy_ecs::prelude::*;
 use glam::{Mat3, Vec3, Vec3A};
 
-use crate::error::{Error, Result, finite, non_negative, positive};
+use crate::core::error::{Error, Result, finite, non_negative, positive};
 use crate::particles::Nodes;
 
 /// The Lamé parameters μ (shear modulus) and λ (Pa).
@@ -216,7 +216,7 @@ impl SoftBody {
         material: Material,
         model: StrainModel,
     ) -> Result<(Nodes, SoftBody)> {
-        let offset = crate::error::finite_vec("soft body offset", offset)?;
+        let offset = crate::core::error::finite_vec("soft body offset", offset)?;
         let points = mesh.points();
         let mut mass = vec![0.0f32; points.len()];
         let (mut dm_inv, mut volume) = (Vec::new(), Vec::new());

@@ -3,16 +3,16 @@
 use bevy_ecs::prelude::*;
 
 use super::SoftBody;
-use crate::WorldPlugin;
-use crate::diagnostics::PhysicsDiagnostics;
-use crate::integrator::{ImplicitEuler, ImplicitState};
-use crate::particles::Nodes;
-use crate::quarantine::{QuarantineReason, Quarantined};
-use crate::schedule::{
+use crate::core::diagnostics::PhysicsDiagnostics;
+use crate::core::plugin::WorldPlugin;
+use crate::core::quarantine::{QuarantineReason, Quarantined};
+use crate::core::schedule::{
     FinishSystems, ForceSystems, PhysicsSchedule, RelaxSystems, SubstepSchedule,
     add_own_force_systems, add_own_systems,
 };
-use crate::time::SubstepTime;
+use crate::core::time::SubstepTime;
+use crate::integrator::{ImplicitEuler, ImplicitState};
+use crate::particles::Nodes;
 
 /// Elastic forces of [`SoftBody`] meshes. Its systems run only while a soft body exists.
 #[derive(Debug, Default, Clone, Copy)]
@@ -20,10 +20,10 @@ pub struct SoftBodyPlugin;
 
 impl WorldPlugin for SoftBodyPlugin {
     fn build(&self, world: &mut World) {
-        crate::whole_step::block_on::<SoftBody>(world);
-        crate::whole_step::block_on::<super::NodeAttachments>(world);
-        crate::whole_step::block_on::<super::NodeTargets>(world);
-        crate::whole_step::block_on::<ImplicitEuler>(world);
+        crate::core::whole_step::block_on::<SoftBody>(world);
+        crate::core::whole_step::block_on::<super::NodeAttachments>(world);
+        crate::core::whole_step::block_on::<super::NodeTargets>(world);
+        crate::core::whole_step::block_on::<ImplicitEuler>(world);
         add_own_force_systems(world, || {
             apply_elastic_forces
                 .run_if(any_with_component::<SoftBody>)
@@ -34,7 +34,7 @@ impl WorldPlugin for SoftBodyPlugin {
             SubstepSchedule,
             solve_implicit
                 .run_if(any_with_component::<ImplicitEuler>)
-                .in_set(crate::schedule::ImplicitSystems::SoftBodies),
+                .in_set(crate::core::schedule::ImplicitSystems::SoftBodies),
         );
         // Attachments first (chained: both move nodes), so that the contacts have the last
         // word on where a node may be.
@@ -62,7 +62,7 @@ impl WorldPlugin for SoftBodyPlugin {
                     .run_if(any_with_component::<super::NodeAttachments>),
             )
                 .chain()
-                .in_set(crate::schedule::PrepareSystems::Inputs),
+                .in_set(crate::core::schedule::PrepareSystems::Inputs),
         );
         add_own_systems(
             world,
@@ -74,7 +74,7 @@ impl WorldPlugin for SoftBodyPlugin {
     }
 }
 
-type Live = (Without<Quarantined>, Without<crate::rest::Sleeping>);
+type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 /// f += −V P(F) Dm⁻ᵀ per tetrahedron; a body whose forces come out non-finite is quarantined.
 fn apply_elastic_forces(
@@ -98,7 +98,7 @@ fn apply_elastic_forces(
 /// quarantined.
 fn solve_implicit(
     mut commands: Commands,
-    guard: Res<crate::quarantine::DivergenceGuard>,
+    guard: Res<crate::core::quarantine::DivergenceGuard>,
     time: Res<SubstepTime>,
     mut bodies: Query<
         (

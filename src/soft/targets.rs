@@ -6,9 +6,9 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::world::DeferredWorld;
 use glam::{Vec3, Vec3A};
 
-use crate::error::{Error, Result, finite_vec};
+use crate::core::error::{Error, Result, finite_vec};
+use crate::core::time::PhysicsTime;
 use crate::particles::Nodes;
-use crate::time::PhysicsTime;
 
 /// Drives some nodes of the [`Nodes`] on the same entity to target positions (m): each step a
 /// targeted node is pinned (infinite mass: the mesh cannot push it) and given the velocity

@@ -4,7 +4,7 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 
 use super::Spring;
-use crate::error::{Error, Result, finite_vec, non_negative, positive};
+use crate::core::error::{Error, Result, finite_vec, non_negative, positive};
 use crate::particles::ParticleBundle;
 
 /// The most nodes a builder makes (2²⁴): far past any rope or cloth a game steps, and small
@@ -45,7 +45,7 @@ impl ChainBuilder {
     ///
     /// **Stability.** Symplectic Euler needs ω_max h < 2 with ω_max ≈ 2√(k/m) for a chain,
     /// i.e. h < √(m/k). The defaults give ω_max h ≈ 1.3 at 60 Hz with one substep; a stiffer
-    /// rope needs substeps (see [`crate::PhysicsTime::new`]).
+    /// rope needs substeps (see [`crate::core::time::PhysicsTime::new`]).
     ///
     /// **Stretch.** Hanging under its own weight, a chain of N nodes stretches by about
     /// m g N² / (2k): soft springs make long ropes sag far (20 default nodes: +1.2 m). For a

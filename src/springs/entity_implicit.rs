@@ -29,7 +29,7 @@
 //! it is (that could overshoot); the price is a bias of about h² g (n − 1) in the static
 //! stretch (0.17 mm for two anchors at 240 Hz). The anchor's prediction follows the arc the
 //! body's spin gives it (see [`End::curve`]). Forces applied at points in
-//! [`crate::StepSystems::AccumulateTorque`] (after this solve) are not in f_ext.
+//! [`crate::core::schedule::StepSystems::AccumulateTorque`] (after this solve) are not in f_ext.
 
 use std::collections::HashMap;
 
@@ -37,12 +37,12 @@ use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 
 use super::{Spinning, Spring, SpringNetwork, anchor_state};
+use crate::core::quarantine::{DivergenceGuard, QuarantineReason, Quarantined};
+use crate::core::time::SubstepTime;
 use crate::integrator::implicit::{Scratch, step};
 use crate::integrator::{ImplicitEuler, ImplicitState, Integrator, IntegratorOverride};
 use crate::particles::{Force, LinearVelocity, Mass, Nodes, Position};
-use crate::quarantine::{DivergenceGuard, QuarantineReason, Quarantined};
 use crate::rigid::{Inertia, Torque};
-use crate::time::SubstepTime;
 
 type Live = Without<Quarantined>;
 
@@ -176,8 +176,9 @@ pub(crate) fn solve_entity_springs(
     let s = &mut *solve;
     s.clear();
     let mut settings = None;
-    // The nodes are numbered, and the system assembled, in spring order (see `crate::order`).
-    let all = crate::order::stable(&springs, archetypes, spring_id.get(), &mut order, |i| i.0);
+    // The nodes are numbered, and the system assembled, in spring order (see `crate::core::order`).
+    let all =
+        crate::core::order::stable(&springs, archetypes, spring_id.get(), &mut order, |i| i.0);
     for (_, spring, flag) in all {
         if !wants_implicit(global, flag.is_some()) {
             continue;

@@ -1,5 +1,5 @@
 //! Springs in the backward-Euler solve ([`crate::integrator::implicit`]): a
-//! [`SpringNetwork`]'s springs as [`ImplicitElements`]. Add [`crate::ImplicitEuler`] to a
+//! [`SpringNetwork`]'s springs as [`ImplicitElements`]. Add [`crate::integrator::ImplicitEuler`] to a
 //! `Nodes` + `SpringNetwork` mesh (a cloth, a rope built as a mesh) to integrate it
 //! implicitly; its spring forces then come from the solve, not from `ForceSystems::Springs`.
 //!
@@ -21,11 +21,11 @@ use bevy_ecs::prelude::*;
 use glam::{DMat3, DVec3, Vec3A};
 
 use super::SpringNetwork;
+use crate::core::quarantine::{DivergenceGuard, QuarantineReason, Quarantined};
+use crate::core::time::SubstepTime;
 use crate::integrator::implicit::{ContactPlane, ImplicitElements, Scratch, step};
 use crate::integrator::{ImplicitEuler, ImplicitState};
 use crate::particles::Nodes;
-use crate::quarantine::{DivergenceGuard, QuarantineReason, Quarantined};
-use crate::time::SubstepTime;
 
 /// A spring at an iterate: its unit direction (zero for coincident ends) and length (m).
 #[derive(Debug, Clone, Copy, Default)]

@@ -26,7 +26,7 @@
 //! Two representations share [`spring_force`]:
 //! - [`Spring`], one entity per spring between two body entities: flexible, for ropes,
 //!   hair and gameplay tethers.
-//! - [`SpringNetwork`] with [`crate::Nodes`] on one entity: arrays of springs over arrays of
+//! - [`SpringNetwork`] with [`crate::particles::Nodes`] on one entity: arrays of springs over arrays of
 //!   nodes, for cloth and anything with thousands of springs. It streams through memory
 //!   instead of looking entities up.
 
@@ -48,9 +48,9 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::world::DeferredWorld;
 use glam::{Vec3, Vec3A};
 
-use crate::error::{Error, Result, finite_vec, non_negative, positive};
+use crate::core::error::{Error, Result, finite_vec, non_negative, positive};
+use crate::core::quarantine::{QuarantineReason, Quarantined};
 use crate::particles::{Nodes, Position};
-use crate::quarantine::{QuarantineReason, Quarantined};
 
 /// The damped spring force on endpoint a (N); the force on b is its negative.
 ///
@@ -145,7 +145,7 @@ impl Spring {
     /// Attaches the ends at points of the bodies (m, relative to each body's centre of mass
     /// in its body axes; for a particle, a fixed world offset). On a rigid body an anchor away
     /// from the centre of mass makes the spring exert a torque r × f. For a point given in
-    /// the shape's frame, subtract the [`crate::CenterOfMass`].
+    /// the shape's frame, subtract the [`crate::rigid::CenterOfMass`].
     ///
     /// # Errors
     /// [`Error::NonFinite`].

@@ -5,15 +5,16 @@ use bevy_ecs::prelude::*;
 use super::{Spring, SpringNetwork, spring_force};
 use glam::Vec3A;
 
+use crate::core::quarantine::{QuarantineReason, Quarantined};
 use crate::particles::{Force, LinearVelocity, Nodes, Position};
-use crate::quarantine::{QuarantineReason, Quarantined};
 use glam::Vec3;
 
-use crate::rigid::{AngularVelocity, Rotation, Torque};
-use crate::schedule::{
+use crate::Error;
+use crate::core::plugin::WorldPlugin;
+use crate::core::schedule::{
     ForceSystems, PhysicsSchedule, PrepareSystems, add_own_force_systems, add_own_systems,
 };
-use crate::{Error, WorldPlugin};
+use crate::rigid::{AngularVelocity, Rotation, Torque};
 
 type Live = Without<Quarantined>;
 
@@ -24,9 +25,9 @@ pub struct SpringPlugin;
 
 impl WorldPlugin for SpringPlugin {
     fn build(&self, world: &mut World) {
-        crate::whole_step::block_on::<Spring>(world);
-        crate::whole_step::block_on::<SpringNetwork>(world);
-        crate::whole_step::block_on::<crate::integrator::ImplicitEuler>(world);
+        crate::core::whole_step::block_on::<Spring>(world);
+        crate::core::whole_step::block_on::<SpringNetwork>(world);
+        crate::core::whole_step::block_on::<crate::integrator::ImplicitEuler>(world);
         add_own_force_systems(world, || {
             (
                 apply_spring_forces.run_if(any_with_component::<Spring>),
@@ -39,22 +40,22 @@ impl WorldPlugin for SpringPlugin {
         // ends kick then drift).
         add_own_systems(
             world,
-            crate::schedule::SubstepSchedule,
+            crate::core::schedule::SubstepSchedule,
             super::entity_implicit::solve_entity_springs
                 .run_if(any_with_component::<Spring>)
                 .in_set(ForceSystems::ImplicitSprings),
         );
         add_own_systems(
             world,
-            crate::schedule::SubstepSchedule,
+            crate::core::schedule::SubstepSchedule,
             super::implicit::solve_implicit_springs
                 .run_if(any_with_component::<crate::integrator::ImplicitEuler>)
-                .in_set(crate::schedule::ImplicitSystems::Springs),
+                .in_set(crate::core::schedule::ImplicitSystems::Springs),
         );
-        crate::restore::init::<super::EntitySpringStability>(world);
-        crate::restore::init::<super::entity_implicit::EntitySpringFactor>(world);
-        crate::restore::init::<super::StabilityPolicy>(world);
-        crate::restore::init::<bevy_ecs::message::Messages<super::StabilityWarning>>(world);
+        crate::core::restore::init::<super::EntitySpringStability>(world);
+        crate::core::restore::init::<super::entity_implicit::EntitySpringFactor>(world);
+        crate::core::restore::init::<super::StabilityPolicy>(world);
+        crate::core::plugin::add_message::<super::StabilityWarning>(world);
         add_own_systems(
             world,
             PhysicsSchedule,
@@ -106,9 +107,9 @@ pub(crate) fn anchor_state(
 #[allow(clippy::too_many_arguments)] // a system: each argument is one query or resource it reads
 fn apply_spring_forces(
     mut commands: Commands,
-    guard: Res<crate::quarantine::DivergenceGuard>,
-    global: Res<crate::Integrator>,
-    springs: Query<(Entity, &Spring, Has<crate::ImplicitEuler>), Live>,
+    guard: Res<crate::core::quarantine::DivergenceGuard>,
+    global: Res<crate::integrator::Integrator>,
+    springs: Query<(Entity, &Spring, Has<crate::integrator::ImplicitEuler>), Live>,
     states: Query<Endpoint, Live>,
     ends: Query<super::entity_implicit::EndBody, Live>,
     spinning: Query<Spinning, Live>,
@@ -123,8 +124,9 @@ fn apply_spring_forces(
     ),
 ) {
     let global = *global;
-    // Forces on a shared end are summed in spring order (see `crate::order`).
-    let all = crate::order::stable(&springs, archetypes, spring_id.get(), &mut order, |i| i.0);
+    // Forces on a shared end are summed in spring order (see `crate::core::order`).
+    let all =
+        crate::core::order::stable(&springs, archetypes, spring_id.get(), &mut order, |i| i.0);
     for (spring, s, flagged) in all {
         if super::entity_implicit::wants_implicit(global, flagged) {
             let accepts = |e: Entity| {
@@ -210,7 +212,7 @@ fn apply_spring_forces(
 /// leaves too, named by it, instead of flying on ballistic.
 fn orphaned(
     commands: &mut Commands,
-    guard: &crate::quarantine::DivergenceGuard,
+    guard: &crate::core::quarantine::DivergenceGuard,
     spring: Entity,
     s: &Spring,
     states: &Query<Endpoint, Live>,
@@ -238,7 +240,7 @@ fn orphaned(
     }
 }
 
-/// Explicit meshes only: an [`crate::ImplicitEuler`] mesh's springs act inside its solve.
+/// Explicit meshes only: an [`crate::integrator::ImplicitEuler`] mesh's springs act inside its solve.
 fn apply_network_forces(
     mut commands: Commands,
     mut meshes: Query<

@@ -16,8 +16,8 @@
 //! springs share one in [`EntitySpringStability`]; both are recomputed when springs or
 //! masses change. When the configured substep dt / substeps exceeds a system's limit under
 //! an explicit integrator, a [`StabilityWarning`] is written once for that system with the
-//! substeps it needs, and [`crate::PhysicsDiagnostics::stability_warnings`] counts it.
-//! Past the limit the springs diverge within a few steps, and [`crate::DivergenceGuard`]
+//! substeps it needs, and [`crate::core::diagnostics::PhysicsDiagnostics::stability_warnings`] counts it.
+//! Past the limit the springs diverge within a few steps, and [`crate::core::quarantine::DivergenceGuard`]
 //! quarantines what runs away.
 //!
 //! **[`StabilityPolicy`]** decides what happens to such a system. The default,
@@ -34,10 +34,10 @@ use std::collections::HashMap;
 use bevy_ecs::prelude::*;
 
 use super::{Spring, SpringNetwork};
-use crate::diagnostics::PhysicsDiagnostics;
+use crate::core::diagnostics::PhysicsDiagnostics;
+use crate::core::time::PhysicsTime;
 use crate::integrator::{ImplicitEuler, Integrator, IntegratorOverride};
 use crate::particles::{Mass, Nodes};
-use crate::time::PhysicsTime;
 
 /// A [`SpringNetwork`] mesh's explicit stability limit (see the module docs).
 #[derive(
@@ -79,7 +79,7 @@ pub enum StabilityPolicy {
     #[default]
     SwitchToImplicit,
     /// Keep integrating it explicitly and write a [`StabilityWarning`]; the
-    /// [`crate::DivergenceGuard`] catches what then runs away.
+    /// [`crate::core::quarantine::DivergenceGuard`] catches what then runs away.
     Warn,
 }
 
@@ -175,7 +175,7 @@ pub(crate) fn check_stability(
             Has<ImplicitEuler>,
             Option<&IntegratorOverride>,
         ),
-        Without<crate::quarantine::Quarantined>,
+        Without<crate::core::quarantine::Quarantined>,
     >,
     springs: Query<(Entity, Ref<Spring>, Has<ImplicitEuler>)>,
     masses: Query<(Ref<Mass>, Option<&IntegratorOverride>)>,

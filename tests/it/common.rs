@@ -45,6 +45,6 @@ pub fn gravity_world(substeps: u32) -> World {
 /// watches stops moving on its own).
 pub fn contact_world(substeps: u32) -> World {
     let mut w = gravity_world(substeps);
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     w
 }

@@ -11,8 +11,11 @@ use bevy_transform::TransformPlugin;
 use bevy_transform::components::{GlobalTransform, Transform};
 use glam::{Quat, Vec3};
 use hooke::bevy::{PhysicsDiagnosticsPlugin, PoseHistory, TransformInterpolation};
+use hooke::collision::CollisionEventsEnabled;
+use hooke::collision::ContactStart;
+use hooke::collision::ContactStarted;
+use hooke::core::time::PhysicsTime;
 use hooke::prelude::*;
-use hooke::{CollisionEventsEnabled, ContactStart, ContactStarted, PhysicsTime};
 
 /// An App with time, transforms and every hooke plugin, whose frames are `frame_hz` long.
 fn app(frame_hz: f64) -> App {

@@ -6,10 +6,14 @@
 
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
+use hooke::Error;
+use hooke::collision::ColliderDensity;
+use hooke::collision::ColliderOf;
+use hooke::collision::ColliderOffset;
+use hooke::core::quarantine::QuarantineReason;
 use hooke::prelude::*;
-use hooke::{
-    CenterOfMass, ColliderDensity, ColliderOf, ColliderOffset, Error, QuarantineReason, scenes,
-};
+use hooke::rigid::CenterOfMass;
+use hooke::scenes;
 
 use crate::common;
 

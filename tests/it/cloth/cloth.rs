@@ -4,12 +4,18 @@
 
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
+use hooke::Error;
+use hooke::cloth::Cloth;
+use hooke::cloth::ClothBuilder;
+use hooke::cloth::ClothMaterial;
+use hooke::core::quarantine::Quarantined;
+use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
-use hooke::{Cloth, ClothBuilder, ClothMaterial, Error, ImplicitEuler, Quarantined, scenes};
+use hooke::scenes;
 
 fn world(substeps: u32, g: Vec3) -> World {
     let mut w = scenes::world_with(1.0 / 60.0, substeps, Integrator::SymplecticEuler, g).unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     w
 }
 
@@ -125,7 +131,7 @@ fn absurd_builder_sizes_are_errors_not_allocation_panics() {
     let huge = ClothBuilder::new(Vec3::ZERO, 1 << 13, 1 << 12, 0.1).build();
     assert!(matches!(huge, Err(Error::OutOfRange { .. })));
     let mut w = world(1, G);
-    let rope = hooke::ChainBuilder::rope(Vec3::ZERO, Vec3::X, usize::MAX).spawn(&mut w);
+    let rope = hooke::springs::ChainBuilder::rope(Vec3::ZERO, Vec3::X, usize::MAX).spawn(&mut w);
     assert!(matches!(rope, Err(Error::OutOfRange { .. })), "{rope:?}");
 }
 
@@ -237,7 +243,7 @@ fn a_flag_in_steady_wind_streams_out_and_stays_bounded() {
     let mut w = world(1, G);
     // The wind blows face-on at the flag at rest (along +z): it turns the flag to stream out
     // along +z.
-    w.spawn(hooke::VelocityField::uniform(Vec3::new(0.0, 0.0, 8.0)).unwrap());
+    w.spawn(hooke::particles::VelocityField::uniform(Vec3::new(0.0, 0.0, 8.0)).unwrap());
     // 20 × 12 nodes, 1 m × 0.55 m, in the x–y plane, its x = 0 edge on the pole.
     let (nx, ny, s) = (20usize, 12usize, 0.05f32);
     let mut x = Vec::new();
@@ -360,7 +366,7 @@ fn a_ball_dropped_on_a_cloth_trampoline_is_caught_and_held() {
             RigidBody::Dynamic,
             Collider::ball(0.1).unwrap(),
             Mass::new(0.5).unwrap(),
-            hooke::Inertia::diagonal(0.002, 0.002, 0.002).unwrap(),
+            hooke::rigid::Inertia::diagonal(0.002, 0.002, 0.002).unwrap(),
             Position::from(Vec3::new(0.0, 1.5, 0.0)),
         ))
         .id();

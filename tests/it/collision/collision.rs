@@ -3,11 +3,18 @@
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
+use hooke::collision::Collider;
+use hooke::collision::CollisionLayers;
+use hooke::collision::ContactEnded;
+use hooke::collision::ContactStarted;
+use hooke::collision::Contacts;
+use hooke::collision::Friction;
+use hooke::collision::Restitution;
+use hooke::collision::Sensor;
 use hooke::prelude::*;
-use hooke::{
-    Collider, CollisionLayers, ContactEnded, ContactStarted, Contacts, Friction, Restitution,
-    RigidBodyBundle, Rotation, Sensor, scenes,
-};
+use hooke::rigid::RigidBodyBundle;
+use hooke::rigid::Rotation;
+use hooke::scenes;
 
 const G: f32 = 9.81;
 
@@ -21,7 +28,7 @@ fn world(substeps: u32) -> World {
         Vec3::new(0.0, -G, 0.0),
     )
     .unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     w
 }
 
@@ -392,14 +399,17 @@ fn nan_in_one_box_of_a_stack_does_not_cross_the_contacts() {
 
 /// The middle box of a 3-column is quarantined; its neighbours stay finite and live.
 fn assert_only_the_middle_box_is_quarantined(w: &World, boxes: &[Entity]) {
-    assert!(w.get::<hooke::Quarantined>(boxes[1]).is_some());
+    assert!(
+        w.get::<hooke::core::quarantine::Quarantined>(boxes[1])
+            .is_some()
+    );
     for &b in [boxes[0], boxes[2]].iter() {
         assert!(
             pos(w, b).is_finite() && vel(w, b).is_finite(),
             "NaN crossed into {b}"
         );
         assert!(
-            w.get::<hooke::Quarantined>(b).is_none(),
+            w.get::<hooke::core::quarantine::Quarantined>(b).is_none(),
             "{b} was quarantined too"
         );
     }
@@ -418,7 +428,9 @@ fn poison(mut bodies: Query<&mut Force, With<Poisoned>>) {
 fn nan_born_mid_step_from_a_force_does_not_cross_the_contacts() {
     let mut w = world(4);
     let boxes = scenes::box_column(&mut w, 3).unwrap();
-    hooke::schedule::add_force_systems(&mut w, || poison.in_set(hooke::ForceSystems::User));
+    hooke::core::schedule::add_force_systems(&mut w, || {
+        poison.in_set(hooke::core::schedule::ForceSystems::User)
+    });
     for _ in 0..30 {
         w.step_physics();
     }
@@ -442,10 +454,10 @@ fn a_box_spun_on_the_ground_stops_at_the_twist_friction_rate() {
     for _ in 0..30 {
         w.step_physics();
     }
-    let inertia = *w.get::<hooke::Inertia>(b).unwrap();
+    let inertia = *w.get::<hooke::rigid::Inertia>(b).unwrap();
     let q = w.get::<Rotation>(b).unwrap().0;
     let omega0 = 5.0;
-    w.get_mut::<hooke::AngularMomentum>(b).unwrap().0 =
+    w.get_mut::<hooke::rigid::AngularMomentum>(b).unwrap().0 =
         inertia.angular_momentum(q, glam::Vec3A::new(0.0, omega0, 0.0));
     let expected = omega0 / (6.0 * 0.5 * G * std::f32::consts::FRAC_1_SQRT_2);
     let mut stopped = None;

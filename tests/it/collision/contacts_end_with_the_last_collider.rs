@@ -4,9 +4,10 @@
 //! after both colliders were removed, held up by a ground that no longer existed.
 
 use bevy_ecs::message::Messages;
+use hooke::collision::ContactEnded;
+use hooke::collision::Contacts;
 use hooke::prelude::*;
 use hooke::scenes;
-use hooke::{ContactEnded, Contacts};
 
 use crate::common;
 

@@ -13,7 +13,8 @@ use crate::common;
 
 fn world(recycle: f32) -> World {
     let mut w = common::contact_world(4);
-    w.resource_mut::<hooke::ContactSettings>().recycle_distance = recycle;
+    w.resource_mut::<hooke::collision::ContactSettings>()
+        .recycle_distance = recycle;
     w
 }
 

@@ -14,7 +14,7 @@ use hooke::scenes;
 
 fn world(g: Vec3) -> World {
     let mut w = scenes::world_with(1.0 / 60.0, 4, Integrator::SymplecticEuler, g).unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     w
 }
 

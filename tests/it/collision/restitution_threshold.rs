@@ -4,8 +4,9 @@
 //! now lowers it for its own contacts.
 
 use glam::Vec3;
+use hooke::collision::RestitutionThreshold;
 use hooke::prelude::*;
-use hooke::{RestitutionThreshold, scenes};
+use hooke::scenes;
 
 /// Drops a 0.1 m ball from 1 m (e = 0.8 on ball and ground) for `seconds`; its apex heights
 /// above the ground (m), one per bounce.
@@ -17,7 +18,7 @@ fn apexes(threshold: Option<f32>, seconds: f32) -> Vec<f32> {
         Vec3::new(0.0, -9.81, 0.0),
     )
     .unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     let ground = scenes::ground(&mut w).unwrap();
     let r = 0.1;
     let ball = scenes::dynamic_ball(&mut w, r, Vec3::new(0.0, 1.0 + r, 0.0)).unwrap();
@@ -78,5 +79,8 @@ fn a_negative_threshold_is_a_typed_error() {
     let ball = scenes::dynamic_ball(&mut w, 0.1, Vec3::ZERO).unwrap();
     w.entity_mut(ball).insert(RestitutionThreshold(-1.0));
     w.step_physics();
-    assert!(w.get::<hooke::Quarantined>(ball).is_some());
+    assert!(
+        w.get::<hooke::core::quarantine::Quarantined>(ball)
+            .is_some()
+    );
 }

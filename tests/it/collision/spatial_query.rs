@@ -3,9 +3,11 @@
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemState;
 use glam::{Quat, Vec3};
+use hooke::collision::Collider;
+use hooke::collision::Sensor;
 use hooke::collision::{QueryFilter, SpatialQuery};
 use hooke::prelude::*;
-use hooke::{Collider, Sensor, scenes};
+use hooke::scenes;
 
 fn scene() -> (World, Entity, Entity) {
     let mut w = scenes::world_with(1.0 / 60.0, 4, Integrator::SymplecticEuler, Vec3::ZERO).unwrap();
@@ -97,7 +99,8 @@ fn point_projection_and_overlaps() {
     let (mut w, ground, b) = scene();
     let sensor = w
         .spawn((
-            hooke::RigidBodyBundle::fixed(Vec3::new(-3.0, 1.0, 0.0), Quat::IDENTITY).unwrap(),
+            hooke::rigid::RigidBodyBundle::fixed(Vec3::new(-3.0, 1.0, 0.0), Quat::IDENTITY)
+                .unwrap(),
             Collider::ball(0.5).unwrap(),
             Sensor,
         ))

@@ -26,9 +26,9 @@ use hooke::scenes;
 fn column(n: usize, substeps: u32, hertz: f32, seconds: f32) -> (f32, f32) {
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
-    w.insert_resource(hooke::PhysicsTime::new(1.0 / 60.0, substeps).unwrap());
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
-    w.resource_mut::<hooke::ContactSettings>().hertz = hertz;
+    w.insert_resource(hooke::core::time::PhysicsTime::new(1.0 / 60.0, substeps).unwrap());
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::collision::ContactSettings>().hertz = hertz;
     let boxes = scenes::box_column(&mut w, n).unwrap();
     let top = *boxes.last().unwrap();
     let start = w.get::<Position>(top).unwrap().get();
@@ -93,7 +93,7 @@ fn perturbed_column_stands(n: usize, offset: f32, run: usize, seconds: f32) -> b
     let specs = scenes::perturbed_column_spec(n, offset, run);
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     let boxes = scenes::spawn_boxes(&mut w, &specs).unwrap();
     let top = *boxes.last().unwrap();
     for _ in 0..(seconds * 60.0).round() as usize {
@@ -129,7 +129,7 @@ fn the_50_row_pyramid_stands_20_s_awake() {
     // One box deep; before, its top leaned out of plane 0.26 m by 10 s and 3.8 m by 15 s.
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     let boxes = scenes::pyramid(&mut w, 50).unwrap();
     let top = *boxes.last().unwrap();
     let start = w.get::<Position>(top).unwrap().get();
@@ -158,9 +158,9 @@ fn the_50_row_pyramid_stands_20_s_awake() {
 fn squeeze(substeps: u32, hertz: f32, seconds: f32) -> (f32, f32, f32) {
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
-    w.insert_resource(hooke::PhysicsTime::new(1.0 / 60.0, substeps).unwrap());
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
-    w.resource_mut::<hooke::ContactSettings>().hertz = hertz;
+    w.insert_resource(hooke::core::time::PhysicsTime::new(1.0 / 60.0, substeps).unwrap());
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::collision::ContactSettings>().hertz = hertz;
     let [low, _, top] = scenes::squeeze(&mut w, 1000.0).unwrap();
     let gap = |w: &World| {
         w.get::<Position>(top).unwrap().get().y - w.get::<Position>(low).unwrap().get().y

@@ -1,15 +1,17 @@
-//! The whole-step path (`hooke::whole_step`): a world of rigid bodies under constant forces
+//! The whole-step path (`hooke::core::whole_step`): a world of rigid bodies under constant forces
 //! runs its substeps in the contact solver's arrays, and must give the substep schedule's
 //! results bit for bit. It must stand aside whenever something else acts in the substeps,
 //! and quarantine exactly as the schedule does.
 
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
+use hooke::core::diagnostics::PhysicsDiagnostics;
+use hooke::core::quarantine::{BodyQuarantined, QuarantineReason, Quarantined};
+use hooke::core::schedule::{ForceSystems, add_force_systems};
+use hooke::core::whole_step::FusedSubsteps;
 use hooke::prelude::*;
-use hooke::quarantine::{BodyQuarantined, QuarantineReason, Quarantined};
 use hooke::rigid::{AngularMomentum, ExternalTorque, Torque};
-use hooke::schedule::{ForceSystems, add_force_systems};
-use hooke::{FusedSubsteps, PhysicsDiagnostics, scenes};
+use hooke::scenes;
 
 /// Bits of every body's x, q, v, L, ω and force and torque accumulators, by entity.
 fn state(world: &mut World) -> Vec<(Entity, Vec<u32>)> {
@@ -205,7 +207,7 @@ fn quarantines_match_the_schedule() {
     let mut worlds = pair(|w| {
         scenes::spawn_boxes(w, &scenes::box_stack_spec(2)).unwrap();
         // Leaves the world's bounds within the first step, in its last substep.
-        let guard = *w.resource::<hooke::quarantine::DivergenceGuard>();
+        let guard = *w.resource::<hooke::core::quarantine::DivergenceGuard>();
         let edge = guard.max_distance - 1.0;
         w.spawn((
             RigidBody::Dynamic,
@@ -247,7 +249,7 @@ fn every_substep_system_is_replicated_or_blocks_the_path() {
         "hooke::collision::plugin::solve_contacts",
         "hooke::collision::plugin::relax_contacts",
         // The timing probes between the sets: nothing to replicate.
-        "hooke::diagnostics::install::{{closure}}",
+        "hooke::core::diagnostics::install::{{closure}}",
     ];
     // Each with the components its effect blocks the path on.
     let blocking = [
@@ -272,11 +274,13 @@ fn every_substep_system_is_replicated_or_blocks_the_path() {
     ];
     let mut world = World::new();
     world.add_physics(PhysicsPlugins);
-    world.schedule_scope(hooke::SubstepSchedule, |world, schedule| {
+    world.schedule_scope(hooke::core::schedule::SubstepSchedule, |world, schedule| {
         schedule.initialize(world).unwrap();
     });
     let schedules = world.resource::<Schedules>();
-    let schedule = schedules.get(hooke::SubstepSchedule).unwrap();
+    let schedule = schedules
+        .get(hooke::core::schedule::SubstepSchedule)
+        .unwrap();
     let names: Vec<String> = schedule
         .systems()
         .unwrap()

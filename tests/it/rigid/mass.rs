@@ -1,8 +1,10 @@
 //! Mass properties from parry shapes against closed forms.
 
 use glam::{Mat3, Quat, Vec3};
+use hooke::Error;
+use hooke::rigid::Inertia;
+use hooke::rigid::MassProperties;
 use hooke::rigid::parallel_axis;
-use hooke::{Error, Inertia, MassProperties};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 use std::f32::consts::PI;

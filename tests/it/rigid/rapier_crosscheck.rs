@@ -4,7 +4,11 @@
 
 use glam::{DMat3, DQuat, DVec3, Quat, Vec3};
 use hooke::prelude::*;
-use hooke::{Inertia, MassProperties, RigidBodyBundle, Rotation, scenes};
+use hooke::rigid::Inertia;
+use hooke::rigid::MassProperties;
+use hooke::rigid::RigidBodyBundle;
+use hooke::rigid::Rotation;
+use hooke::scenes;
 use parry3d::shape::SharedShape;
 use rapier3d::prelude as rp;
 

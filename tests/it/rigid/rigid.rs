@@ -3,11 +3,21 @@
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3, Vec3A};
 use hooke::prelude::*;
-use hooke::{
-    AngularMomentum, AngularVelocity, ExternalForceAtPoint, ExternalImpulseAtPoint, ExternalTorque,
-    Inertia, KinematicTarget, MassProperties, OrientationUpdate, Renormalization, RigidBody,
-    RigidBodyBundle, Rotation, SkipRenormalization, scenes,
-};
+use hooke::rigid::AngularMomentum;
+use hooke::rigid::AngularVelocity;
+use hooke::rigid::ExternalForceAtPoint;
+use hooke::rigid::ExternalImpulseAtPoint;
+use hooke::rigid::ExternalTorque;
+use hooke::rigid::Inertia;
+use hooke::rigid::KinematicTarget;
+use hooke::rigid::MassProperties;
+use hooke::rigid::OrientationUpdate;
+use hooke::rigid::Renormalization;
+use hooke::rigid::RigidBody;
+use hooke::rigid::RigidBodyBundle;
+use hooke::rigid::Rotation;
+use hooke::rigid::SkipRenormalization;
+use hooke::scenes;
 
 fn world(dt: f32, substeps: u32, integrator: Integrator) -> World {
     scenes::world_with(dt, substeps, integrator, Vec3::ZERO).unwrap()
@@ -285,7 +295,7 @@ fn force_at_the_centre_of_mass_does_not_rotate_and_torque_is_r_cross_f() {
     w.step_physics();
     assert_eq!(omega(&w, centred), Vec3::ZERO);
     assert!(w.get::<LinearVelocity>(centred).unwrap().0.x > 0.0);
-    let tau = w.get::<hooke::Torque>(lever).unwrap().0;
+    let tau = w.get::<hooke::rigid::Torque>(lever).unwrap().0;
     assert!((tau - Vec3A::new(0.0, 0.0, -5.0)).length() < 1e-5, "{tau}");
     assert!(omega(&w, lever).z < 0.0);
     // Both translate alike: the lever's force also acts on the centre of mass.
@@ -330,7 +340,7 @@ fn external_torque_and_point_impulse() {
 #[test]
 fn kinematic_bodies_follow_velocities_and_targets_static_bodies_never_move() {
     let mut w = world(0.1, 1, Integrator::SymplecticEuler);
-    w.insert_resource(hooke::Gravity::EARTH);
+    w.insert_resource(hooke::particles::Gravity::EARTH);
     let driven = w
         .spawn(
             RigidBodyBundle::kinematic()
@@ -404,7 +414,7 @@ fn box_hanging_from_a_corner_spring_settles_at_the_static_equilibrium() {
                 .at(Vec3::new(0.4, 1.0, 0.1))
                 .unwrap(),
             LinearDamping(0.5),
-            hooke::AngularDamping(1.0),
+            hooke::rigid::AngularDamping(1.0),
         ))
         .id();
     let (k, rest) = (3000.0, 0.5);
@@ -477,7 +487,10 @@ fn bad_rigid_input_is_rejected_or_quarantined() {
     w.entity_mut(e)
         .insert(Rotation(Quat::from_xyzw(f32::NAN, 0.0, 0.0, 1.0)));
     let f = w
-        .spawn((RigidBodyBundle::kinematic(), hooke::AngularDamping(-1.0)))
+        .spawn((
+            RigidBodyBundle::kinematic(),
+            hooke::rigid::AngularDamping(-1.0),
+        ))
         .id();
     w.flush();
     assert!(w.get::<Quarantined>(e).is_some());

@@ -5,11 +5,15 @@ use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemState;
 use glam::{Quat, Vec3, Vec3A};
+use hooke::collision::ContactSettings;
 use hooke::collision::{QueryFilter, SpatialQuery};
+use hooke::core::restore::{InvalidSetting, ResourceRestored};
+use hooke::core::time::SubstepTime;
 use hooke::parry3d::shape::SharedShape;
 use hooke::prelude::*;
-use hooke::restore::{InvalidSetting, ResourceRestored};
-use hooke::*;
+use hooke::rigid::AngularMomentum;
+use hooke::scenes;
+use hooke::sleep::SleepSettings;
 
 fn world() -> World {
     scenes::world_with(

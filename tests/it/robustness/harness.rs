@@ -6,13 +6,16 @@
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
 use bevy_ecs::prelude::*;
+use hooke::collision::RestitutionThreshold;
+use hooke::core::time::PhysicsTime;
+use hooke::integrator::ImplicitEuler;
+use hooke::particles::ExternalImpulse;
 use hooke::prelude::*;
+use hooke::rigid::AngularVelocity;
+use hooke::rigid::KinematicTarget;
+use hooke::scenes;
 use hooke::snapshot::Snapshot;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
-use hooke::{
-    AngularVelocity, ExternalImpulse, ImplicitEuler, KinematicTarget, PhysicsTime,
-    RestitutionThreshold, scenes,
-};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestError, TestRng, TestRunner};
 
@@ -109,7 +112,7 @@ fn constructors(
     call(t, || Mass::new(a));
     call(t, || ParticleBundle::new(u, v, a));
     call(t, || ParticleBundle::pinned(u));
-    call(t, || hooke::Gravity::new(u));
+    call(t, || hooke::particles::Gravity::new(u));
     call(t, || VelocityField::uniform(u));
     call(t, || VelocityField::vortex(u, v, a));
     call(t, || Spring::new(e, f, a, b, c));
@@ -495,7 +498,7 @@ fn apply(world: &mut World, all: &[Entity], m: &Meddle) {
             }
         }
         Meddle::Settings(v) => {
-            let mut s = world.resource_mut::<hooke::ContactSettings>();
+            let mut s = world.resource_mut::<hooke::collision::ContactSettings>();
             s.margin = v;
             if let Ok(mut t) = world.get_entity_mut(e) {
                 t.insert(RestitutionThreshold(v));
@@ -620,7 +623,7 @@ pub fn run_world(case: &WorldCase, tally: &mut Tally, check_snapshot: bool) {
             copy.add_physics(PhysicsPlugins);
             let map = match read.restore(&mut copy) {
                 Ok(map) => map,
-                Err(hooke::Error::Snapshot(hooke::snapshot::SnapshotError::Invalid { .. })) => {
+                Err(hooke::snapshot::SnapshotError::Invalid { .. }) => {
                     return (silent, quarantined, false, true);
                 }
                 Err(e) => panic!("own snapshot not restored: {e}"),

@@ -151,10 +151,20 @@ fn a_failing_expectation_is_reported_with_its_time_and_value() {
 }
 
 #[test]
-fn hooke_errors_carry_scenario_errors_for_question_marks() {
-    fn user_test() -> hooke::Result<()> {
+fn scenario_errors_carry_hooke_errors_and_both_pass_through_question_marks() {
+    fn user_test() -> Result<(), Box<dyn std::error::Error>> {
+        let _ball = hooke::prelude::Collider::ball(0.5)?;
         load("unknown_entity.ron")?;
         Ok(())
     }
-    assert!(matches!(user_test(), Err(hooke::Error::Scenario(_))));
+    let e = user_test().unwrap_err();
+    assert!(e.downcast_ref::<ScenarioError>().is_some(), "{e}");
+    let bad = load("bad_value.ron").unwrap().run().unwrap_err();
+    assert!(
+        matches!(
+            bad.kind,
+            ScenarioErrorKind::Build(hooke::Error::NotPositive { .. })
+        ),
+        "{bad}"
+    );
 }

@@ -4,9 +4,11 @@ use crate::common;
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
+use hooke::core::schedule::ForceSchedule;
+use hooke::core::schedule::PhysicsSchedule;
+use hooke::core::schedule::SubstepSchedule;
 use hooke::prelude::*;
 use hooke::scenes;
-use hooke::{ForceSchedule, PhysicsSchedule, SubstepSchedule};
 
 fn assert_no_ambiguities(world: &mut World, label: impl ScheduleLabel + Clone) {
     let result = world.schedule_scope(label.clone(), |world, schedule| {
@@ -73,7 +75,7 @@ fn run_pile(steps: usize) -> (Vec<u32>, usize) {
         slept = slept.max(
             boxes
                 .iter()
-                .filter(|&&b| world.get::<hooke::Sleeping>(b).is_some())
+                .filter(|&&b| world.get::<hooke::core::rest::Sleeping>(b).is_some())
                 .count(),
         );
     }
@@ -111,7 +113,7 @@ fn plugins_are_added_once_and_a_world_without_physics_steps_harmlessly() {
     world
         .add_physics(PhysicsPlugins)
         .add_physics(PhysicsPlugins)
-        .add_physics(hooke::GravityPlugin);
+        .add_physics(hooke::particles::GravityPlugin);
     let e = world
         .spawn(ParticleBundle::new(Vec3::ZERO, Vec3::ZERO, 1.0).unwrap())
         .id();
@@ -125,7 +127,7 @@ fn plugins_are_added_once_and_a_world_without_physics_steps_harmlessly() {
 fn a_scene_gets_only_the_plugins_it_asks_for() {
     // No gravity plugin: a particle with an external force moves, but doesn't fall.
     let mut world = World::new();
-    world.add_physics(hooke::PhysicsCorePlugin);
+    world.add_physics(hooke::core::plugin::PhysicsCorePlugin);
     let e = world
         .spawn((
             ParticleBundle::new(Vec3::ZERO, Vec3::ZERO, 1.0).unwrap(),
@@ -169,6 +171,11 @@ fn diagnostics_report_energy_counts_and_set_timings() {
     assert!(c.mesh_springs > 0);
     assert!(d.kinetic_energy > 0.0 && d.spring_energy >= 0.0);
     assert!(d.step_time > std::time::Duration::ZERO);
-    assert!(d.set_time(hooke::StepSystems::ApplyForces) > std::time::Duration::ZERO);
-    assert!(d.set_time(hooke::StepSystems::IntegrateVelocities) > std::time::Duration::ZERO);
+    assert!(
+        d.set_time(hooke::core::schedule::StepSystems::ApplyForces) > std::time::Duration::ZERO
+    );
+    assert!(
+        d.set_time(hooke::core::schedule::StepSystems::IntegrateVelocities)
+            > std::time::Duration::ZERO
+    );
 }

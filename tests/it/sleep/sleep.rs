@@ -2,8 +2,11 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::core::rest::Sleeping;
+use hooke::core::rest::SleepingDisabled;
 use hooke::prelude::*;
-use hooke::{SleepSettings, Sleeping, SleepingDisabled, scenes};
+use hooke::scenes;
+use hooke::sleep::SleepSettings;
 
 use crate::common;
 

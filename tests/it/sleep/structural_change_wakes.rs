@@ -6,8 +6,10 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::collision::Contacts;
+use hooke::core::rest::Sleeping;
 use hooke::prelude::*;
-use hooke::{Contacts, Sleeping, scenes};
+use hooke::scenes;
 
 /// A 5-box column of unit boxes on the ground at the defaults, asleep.
 fn sleeping_stack() -> (World, Entity, Vec<Entity>) {

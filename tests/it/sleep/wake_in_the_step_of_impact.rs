@@ -4,8 +4,9 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::core::rest::Sleeping;
 use hooke::prelude::*;
-use hooke::{Sleeping, scenes};
+use hooke::scenes;
 
 use crate::common;
 

@@ -4,13 +4,18 @@
 
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
+use hooke::core::quarantine::Quarantined;
+use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
+use hooke::rigid::AngularMomentum;
+use hooke::rigid::Inertia;
+use hooke::rigid::RigidBody;
+use hooke::scenes;
 use hooke::soft::{CellSplit, Material, NodeAttachments, SoftBody, StrainModel, TetMesh};
-use hooke::{AngularMomentum, ImplicitEuler, Inertia, Quarantined, RigidBody, scenes};
 
 fn world(g: Vec3) -> World {
     let mut w = scenes::world_with(1.0 / 60.0, 1, Integrator::SymplecticEuler, g).unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     w
 }
 
@@ -102,11 +107,11 @@ fn an_explicit_bar_holds_the_box_too() {
         Vec3::new(0.0, -9.81, 0.0),
     )
     .unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     let (nodes, body, bottom) = bar(young, density);
     // Undamped otherwise: the box's own damping settles the oscillation.
     let b = rigid_box(&mut w, Vec3::new(0.0, -0.05, 0.0), kg);
-    w.entity_mut(b).insert(hooke::LinearDamping(2.0));
+    w.entity_mut(b).insert(hooke::particles::LinearDamping(2.0));
     let soft = w
         .spawn((
             nodes,
@@ -159,7 +164,7 @@ fn momentum_passes_exactly_between_a_free_soft_body_and_its_rigid_body() {
             Vec3::ZERO,
         )
         .unwrap();
-        w.resource_mut::<hooke::SleepSettings>().enabled = false;
+        w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
         let mesh = TetMesh::cuboid(Vec3::splat(0.2), [2, 2, 2], CellSplit::Five).unwrap();
         let material = Material::new(if implicit { 1e6 } else { 2e3 }, 0.3, 500.0).unwrap();
         let (nodes, body) =
@@ -170,7 +175,7 @@ fn momentum_passes_exactly_between_a_free_soft_body_and_its_rigid_body() {
         let b = rigid_box(&mut w, Vec3::new(0.15, 0.0, 0.0), 2.0);
         w.entity_mut(b).insert((
             LinearVelocity::from(Vec3::new(0.5, 1.0, -0.3)),
-            hooke::AngularVelocity::from(Vec3::new(0.0, 0.0, 2.0)),
+            hooke::rigid::AngularVelocity::from(Vec3::new(0.0, 0.0, 2.0)),
         ));
         let mut e = w.spawn((nodes, body, NodeAttachments::new(b, face).unwrap()));
         if implicit {
@@ -225,7 +230,7 @@ fn a_kinematic_body_carries_its_nodes_and_a_despawned_one_lets_go() {
             RigidBody::Kinematic,
             Position::from(Vec3::new(0.0, 1.05, 0.0)),
             LinearVelocity::from(Vec3::new(1.0, 0.0, 0.0)),
-            hooke::Rotation(Quat::IDENTITY),
+            hooke::rigid::Rotation(Quat::IDENTITY),
         ))
         .id();
     let soft = w

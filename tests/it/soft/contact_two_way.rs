@@ -4,13 +4,18 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::collision::Collider;
+use hooke::core::quarantine::Quarantined;
+use hooke::integrator::ImplicitEuler;
+use hooke::particles::GravityScale;
 use hooke::prelude::*;
+use hooke::rigid::RigidBody;
+use hooke::scenes;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
-use hooke::{Collider, GravityScale, ImplicitEuler, Quarantined, RigidBody, scenes};
 
 fn world(g: Vec3, substeps: u32) -> World {
     let mut w = scenes::world_with(1.0 / 60.0, substeps, Integrator::SymplecticEuler, g).unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     w
 }
 
@@ -28,7 +33,7 @@ fn platform_scene(implicit: bool) -> (World, Entity, Entity, f32, f32) {
             RigidBody::Dynamic,
             Collider::cuboid(0.5, 0.05, 0.5).unwrap(),
             Mass::new(platform_kg).unwrap(),
-            hooke::Inertia::diagonal(0.42, 0.83, 0.42).unwrap(),
+            hooke::rigid::Inertia::diagonal(0.42, 0.83, 0.42).unwrap(),
             Position::from(Vec3::ZERO),
             GravityScale(0.0),
         ))
@@ -92,7 +97,7 @@ fn a_soft_cube_on_a_floating_platform_drags_it_down_at_m_g_over_the_total_mass()
         // Pressed evenly, the light platform barely tips in this second; it does tip over
         // longer runs (see the module docs of `soft::contact`).
         let tilt = w
-            .get::<hooke::Rotation>(platform)
+            .get::<hooke::rigid::Rotation>(platform)
             .unwrap()
             .0
             .angle_between(glam::Quat::IDENTITY);
@@ -110,7 +115,7 @@ fn a_soft_ball_thrown_at_a_free_box_keeps_the_momentum_of_the_pair() {
                 RigidBody::Dynamic,
                 Collider::cuboid(0.2, 0.2, 0.2).unwrap(),
                 Mass::new(big_m).unwrap(),
-                hooke::Inertia::diagonal(0.107, 0.107, 0.107).unwrap(),
+                hooke::rigid::Inertia::diagonal(0.107, 0.107, 0.107).unwrap(),
                 Position::from(Vec3::new(1.0, 0.05, 0.0)),
             ))
             .id();
@@ -168,7 +173,7 @@ fn a_jelly_dropped_on_a_crate_on_the_ground_comes_to_rest_on_it() {
                 RigidBody::Dynamic,
                 Collider::cuboid(0.4, 0.2, 0.4).unwrap(),
                 Mass::new(10.0).unwrap(),
-                hooke::Inertia::diagonal(0.67, 1.07, 0.67).unwrap(),
+                hooke::rigid::Inertia::diagonal(0.67, 1.07, 0.67).unwrap(),
                 Position::from(Vec3::new(0.0, 0.2, 0.0)),
             ))
             .id();

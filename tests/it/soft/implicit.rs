@@ -3,13 +3,14 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
+use hooke::scenes;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
-use hooke::{ImplicitEuler, scenes};
 
 fn world(g: Vec3, dt: f32, substeps: u32) -> World {
     let mut w = scenes::world_with(dt, substeps, Integrator::SymplecticEuler, g).unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     w
 }
 

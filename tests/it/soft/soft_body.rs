@@ -3,9 +3,10 @@
 
 use bevy_ecs::prelude::*;
 use glam::{DVec3, Mat3, Vec3, Vec3A};
+use hooke::Error;
 use hooke::prelude::*;
+use hooke::scenes;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
-use hooke::{Error, scenes};
 
 #[test]
 fn meshes_are_validated() {
@@ -78,7 +79,7 @@ fn generated_meshes_have_the_right_volume_and_a_closed_surface() {
 
 fn world(g: Vec3, dt: f32, substeps: u32) -> World {
     let mut w = scenes::world_with(dt, substeps, Integrator::SymplecticEuler, g).unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     w
 }
 

@@ -4,8 +4,10 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::particles::LinearDamping;
 use hooke::prelude::*;
-use hooke::{ChainBuilder, LinearDamping, Spring};
+use hooke::springs::ChainBuilder;
+use hooke::springs::Spring;
 
 fn world() -> World {
     let mut w = World::new();
@@ -58,7 +60,7 @@ fn a_hanging_chain_with_a_load_has_each_spring_carry_the_weight_below_it() {
 #[test]
 fn a_rope_pinned_at_both_ends_and_pre_tensioned_holds_its_tension() {
     let mut w = world();
-    w.insert_resource(hooke::Gravity::new(Vec3::ZERO).unwrap());
+    w.insert_resource(hooke::particles::Gravity::new(Vec3::ZERO).unwrap());
     let (k, scale) = (500.0f32, 0.9f32);
     let chain = ChainBuilder::rope(Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0), 9)
         .stiffness(k)
@@ -131,7 +133,7 @@ fn a_rope_between_two_pins_hangs_on_the_catenary() {
     build().spawn(&mut probe).unwrap();
     probe.step_physics();
     let needed = {
-        let m = probe.resource::<bevy_ecs::message::Messages<hooke::StabilityWarning>>();
+        let m = probe.resource::<bevy_ecs::message::Messages<hooke::springs::StabilityWarning>>();
         m.get_cursor().read(m).next().unwrap().substeps_needed
     };
     let mut w = hooke::scenes::world_with(

@@ -7,11 +7,14 @@ use crate::common;
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::core::quarantine::Quarantined;
+use hooke::core::time::PhysicsTime;
+use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
-use hooke::{
-    ChainBuilder, ImplicitEuler, PhysicsTime, Quarantined, StabilityPolicy, StabilityWarning,
-    scenes,
-};
+use hooke::scenes;
+use hooke::springs::ChainBuilder;
+use hooke::springs::StabilityPolicy;
+use hooke::springs::StabilityWarning;
 
 fn warnings(w: &World) -> Vec<StabilityWarning> {
     let m = w.resource::<Messages<StabilityWarning>>();
@@ -304,7 +307,7 @@ fn leaving_the_implicit_dial_takes_the_dials_solver_off_the_meshes() {
 
 /// 10 links of 1 kg holding 10,000 kg, k = 1e6 N/m and c = 2e5 N·s/m per link, hung
 /// straight down from (0, 5, 0).
-fn loaded_chain(w: &mut World) -> hooke::Chain {
+fn loaded_chain(w: &mut World) -> hooke::springs::Chain {
     ChainBuilder::rope(Vec3::new(0.0, 5.0, 0.0), Vec3::new(0.0, 4.0, 0.0), 11)
         .node_mass(1.0)
         .stiffness(1e6)
@@ -315,7 +318,7 @@ fn loaded_chain(w: &mut World) -> hooke::Chain {
 }
 
 /// 30 nodes of 1 g over 1 m between two pins, pre-stretched 5 %, k = 1e5 N/m.
-fn taut_string(w: &mut World) -> hooke::Chain {
+fn taut_string(w: &mut World) -> hooke::springs::Chain {
     ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0), 30)
         .node_mass(0.001)
         .stiffness(1e5)
@@ -328,7 +331,7 @@ fn taut_string(w: &mut World) -> hooke::Chain {
 
 /// 1 g beads on springs of 1e6 N/m (ω = 3e4 rad/s, 130 times the substep's limit): a 0.5 m
 /// rope from a pin at (0, 1, 0), released horizontal.
-fn stiff_beads(w: &mut World) -> hooke::Chain {
+fn stiff_beads(w: &mut World) -> hooke::springs::Chain {
     ChainBuilder::rope(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.5, 1.0, 0.0), 6)
         .node_mass(0.001)
         .stiffness(1e6)
@@ -499,7 +502,7 @@ fn without_springs_the_implicit_dial_is_symplectic_euler_bit_for_bit() {
             .map(|&b| {
                 (
                     w.get::<Position>(b).unwrap().0,
-                    w.get::<hooke::Rotation>(b).unwrap().0,
+                    w.get::<hooke::rigid::Rotation>(b).unwrap().0,
                 )
             })
             .collect::<Vec<_>>()

@@ -6,12 +6,16 @@
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::cloth::ClothBuilder;
+use hooke::core::quarantine::Quarantined;
+use hooke::integrator::ImplicitEuler;
+use hooke::integrator::ImplicitState;
 use hooke::prelude::*;
-use hooke::{ClothBuilder, ImplicitEuler, ImplicitState, Quarantined, scenes};
+use hooke::scenes;
 
 fn world(dt: f32, substeps: u32, g: Vec3) -> World {
     let mut w = scenes::world_with(dt, substeps, Integrator::SymplecticEuler, g).unwrap();
-    w.resource_mut::<hooke::SleepSettings>().enabled = false;
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
     w
 }
 

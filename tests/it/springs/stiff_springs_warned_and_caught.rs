@@ -9,17 +9,21 @@
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
+use hooke::core::quarantine::BodyQuarantined;
+use hooke::core::quarantine::DivergenceGuard;
+use hooke::core::quarantine::QuarantineReason;
+use hooke::core::quarantine::Quarantined;
+use hooke::core::time::PhysicsTime;
 use hooke::prelude::*;
-use hooke::{
-    BodyQuarantined, DivergenceGuard, PhysicsTime, QuarantineReason, Quarantined, SpringStability,
-    StabilityWarning, scenes,
-};
+use hooke::scenes;
+use hooke::springs::SpringStability;
+use hooke::springs::StabilityWarning;
 
 /// The defaults, but springs past their limit stay explicit.
 fn default_world() -> World {
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
-    w.insert_resource(hooke::StabilityPolicy::Warn);
+    w.insert_resource(hooke::springs::StabilityPolicy::Warn);
     w
 }
 
@@ -30,10 +34,10 @@ fn warnings(w: &World) -> Vec<StabilityWarning> {
 
 /// 20 nodes of 0.1 kg over 1 m, k such that the top segment stretches 0.1 % under the
 /// rope's weight: k = 20 · 0.1 · 9.81 / (0.0526 · 1e-3) ≈ 3.7e5 N/m.
-fn stiff_rope() -> hooke::ChainBuilder {
+fn stiff_rope() -> hooke::springs::ChainBuilder {
     let weight = 20.0 * 0.1 * 9.81;
     let segment = 1.0 / 19.0;
-    hooke::ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0), 20)
+    hooke::springs::ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0), 20)
         .stiffness(weight / (segment * 1e-3))
 }
 
@@ -146,7 +150,7 @@ fn the_critical_step_of_a_two_mass_spring_is_the_closed_form_and_is_the_edge() {
     for (factor, stable) in [(0.95f32, true), (1.05, false)] {
         let mut w = scenes::world_with(factor * closed, 1, Integrator::SymplecticEuler, Vec3::ZERO)
             .unwrap();
-        w.insert_resource(hooke::StabilityPolicy::Warn);
+        w.insert_resource(hooke::springs::StabilityPolicy::Warn);
         let e = w.spawn((nodes.clone(), net.clone())).id();
         let mut peak = 0.0f32;
         for _ in 0..2000 {
@@ -182,7 +186,7 @@ fn the_critical_step_of_a_two_mass_spring_is_the_closed_form_and_is_the_edge() {
 #[test]
 fn a_stiff_cloth_is_told_and_its_runaway_node_named() {
     let mut w = default_world();
-    let cloth = hooke::ClothBuilder::new(Vec3::new(0.0, 2.0, 0.0), 16, 16, 0.05)
+    let cloth = hooke::cloth::ClothBuilder::new(Vec3::new(0.0, 2.0, 0.0), 16, 16, 0.05)
         .stiffness(2e5, 2e4, 2e3)
         .spawn(&mut w)
         .unwrap();
@@ -221,7 +225,7 @@ fn torn_spring(w: &mut World) -> (Entity, Entity, Entity) {
     let ball = w
         .spawn(ParticleBundle::new(Vec3::new(0.0, -150.0, 0.0), Vec3::ZERO, 1.0).unwrap())
         .id();
-    let spring = hooke::Spring::from_hooke(hook, ball, 1.0, 10.0, 0.0)
+    let spring = hooke::springs::Spring::from_hooke(hook, ball, 1.0, 10.0, 0.0)
         .unwrap()
         .spawn(w)
         .unwrap();

@@ -17,13 +17,13 @@ use std::time::{Duration, Instant};
 use bevy_ecs::prelude::*;
 use glam::{DVec3, Vec3};
 
-use crate::particles::{Gravity, LinearVelocity, Mass, Nodes, Position, Tracer};
-use crate::quarantine::{QuarantineReason, Quarantined};
-use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, rotational_energy};
-use crate::schedule::{
+use crate::core::quarantine::{QuarantineReason, Quarantined};
+use crate::core::schedule::{
     FinishSystems, PhysicsSchedule, PhysicsSystems, ProbeSystems, StepSystems, SubstepSchedule,
     add_own_systems,
 };
+use crate::particles::{Gravity, LinearVelocity, Mass, Nodes, Position, Tracer};
+use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, rotational_energy};
 use crate::springs::{Endpoint, Spinning, Spring, SpringNetwork, anchor_state, spring_energy};
 
 /// How many things of each kind the world holds (quarantined ones counted apart).
@@ -70,7 +70,7 @@ pub struct PhysicsDiagnostics {
     /// Zero after a step on the whole-step path, which has no sets.
     pub set_times: [Duration; 9],
     /// Whether the last step ran its substeps on the whole-step path (see
-    /// [`crate::whole_step`]) instead of through [`crate::SubstepSchedule`].
+    /// [`crate::core::whole_step`]) instead of through [`crate::core::schedule::SubstepSchedule`].
     pub whole_step: bool,
     /// Wall time of the whole last step.
     pub step_time: Duration,
@@ -130,10 +130,10 @@ struct SetClock {
 }
 
 pub(crate) fn install(world: &mut World) {
-    crate::restore::init::<PhysicsDiagnostics>(world);
+    crate::core::restore::init::<PhysicsDiagnostics>(world);
     world.add_observer(count_quarantine);
-    crate::restore::init::<DiagnosticsSettings>(world);
-    crate::restore::init::<SetClock>(world);
+    crate::core::restore::init::<DiagnosticsSettings>(world);
+    crate::core::restore::init::<SetClock>(world);
     for k in 0..=9u8 {
         add_own_systems(
             world,

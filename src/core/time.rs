@@ -8,8 +8,8 @@
 
 use bevy_ecs::prelude::*;
 
-use crate::error::{Error, Result};
-use crate::schedule::SubstepSchedule;
+use crate::core::error::{Error, Result};
+use crate::core::schedule::SubstepSchedule;
 
 /// The fixed step and the simulation clock.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone)]
@@ -183,18 +183,15 @@ pub struct FrameReport {
 }
 
 /// Runs the substep schedule `substeps` times. The only system in `PhysicsSystems::Step`.
-/// A world where `Bodies` (the filter of anything the substeps could move, given by the
-/// core plugin) matches nothing only advances its clock.
-pub(crate) fn run_substeps<Bodies: bevy_ecs::query::QueryFilter>(
-    world: &mut World,
-    bodies: &mut QueryState<(), Bodies>,
-) {
+/// A world where nothing registered as moving ([`crate::core::plugin::moves`]) exists only
+/// advances its clock.
+pub(crate) fn run_substeps(world: &mut World) {
     if !world.contains_resource::<PhysicsTime>() {
         return;
     }
-    let empty = bodies.iter(world).next().is_none();
+    let empty = !crate::core::plugin::anything_moves(world);
     // An effect that ran the whole step leaves only the clock to advance.
-    let done = empty || crate::whole_step::try_whole_step(world);
+    let done = empty || crate::core::whole_step::try_whole_step(world);
     let Some(time) = world.get_resource::<PhysicsTime>() else {
         return;
     };

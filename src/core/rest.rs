@@ -1,5 +1,5 @@
 //! Rest state that every integrating system skips: [`Sleeping`] bodies (put to sleep and
-//! woken by the sleep plugin), next to [`crate::Quarantined`] ones.
+//! woken by the sleep plugin), next to [`crate::core::quarantine::Quarantined`] ones.
 //!
 //! These markers live in the core, not in the sleep plugin, so that particles, rigid bodies
 //! and contacts can skip sleeping bodies without depending on the plugin that decides who

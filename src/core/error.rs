@@ -113,7 +113,7 @@ pub enum Error {
         /// The number of nodes.
         len: usize,
     },
-    /// A component a simulated body needs was removed from it (e.g. [`crate::Mass`] from a
+    /// A component a simulated body needs was removed from it (e.g. [`crate::particles::Mass`] from a
     /// particle or a dynamic body).
     #[error("the body's {0} was removed; insert one and remove Quarantined to simulate it again")]
     ComponentRemoved(&'static str),
@@ -123,18 +123,6 @@ pub enum Error {
     /// An error read back from a snapshot (the message of the error it was).
     #[error("{0}")]
     Restored(String),
-    /// A scenario file is bad (with its line).
-    #[error(transparent)]
-    Scenario(Box<crate::scenario::ScenarioError>),
-    /// A snapshot could not be read or restored.
-    #[error(transparent)]
-    Snapshot(#[from] crate::snapshot::SnapshotError),
-}
-
-impl From<crate::scenario::ScenarioError> for Error {
-    fn from(e: crate::scenario::ScenarioError) -> Self {
-        Error::Scenario(Box::new(e))
-    }
 }
 
 /// Shorthand for hooke results.

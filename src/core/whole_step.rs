@@ -1,7 +1,7 @@
 //! The whole-step path: one effect runs all of a step's substeps itself, in its own arrays,
 //! when nothing else in the world needs the ECS between substeps.
 //!
-//! Each substep of [`crate::SubstepSchedule`] reads every moving body's state out of the ECS
+//! Each substep of [`crate::core::schedule::SubstepSchedule`] reads every moving body's state out of the ECS
 //! and writes it back, system by system: forces, the velocity half, the contact solver's
 //! two passes (each with a gather and a scatter), the position half, renormalisation. For a
 //! world of rigid bodies under constant forces that round trip is most of the step's cost
@@ -13,7 +13,7 @@
 //!
 //! The runner is tried only when the schedule would do nothing it does not replicate:
 //! - [`FusedSubsteps`] is on (the default);
-//! - the substep schedule holds only hooke's own systems ([`crate::schedule`] counts them):
+//! - the substep schedule holds only hooke's own systems ([`crate::core::schedule`] counts them):
 //!   a game system in the substeps (a force written every substep) keeps the schedule;
 //! - no entity holds a component registered with [`block_on`]. Each effect whose substep
 //!   systems the runner does not replicate (springs, damping, meshes, tracers, forces at
@@ -26,10 +26,10 @@
 use bevy_ecs::component::ComponentId;
 use bevy_ecs::prelude::*;
 
-use crate::schedule::{OwnSubstepSystems, SubstepSchedule};
+use crate::core::schedule::{OwnSubstepSystems, SubstepSchedule};
 
 /// Whether the whole-step path may run (default: on). Off forces every substep through
-/// [`crate::SubstepSchedule`]; results are the same bit for bit, so this is only for
+/// [`crate::core::schedule::SubstepSchedule`]; results are the same bit for bit, so this is only for
 /// comparisons and for debugging a game system placed in the substeps.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct FusedSubsteps(pub bool);
@@ -77,7 +77,9 @@ pub(crate) fn try_whole_step(world: &mut World) -> bool {
     let runner = world.get_resource::<WholeStepRunner>().copied();
     let on = world.get_resource::<FusedSubsteps>().is_some_and(|f| f.0);
     let (Some(runner), true) = (runner, on) else {
-        if let Some(mut d) = world.get_resource_mut::<crate::PhysicsDiagnostics>() {
+        if let Some(mut d) =
+            world.get_resource_mut::<crate::core::diagnostics::PhysicsDiagnostics>()
+        {
             d.whole_step = false;
         }
         return false;
@@ -91,7 +93,7 @@ pub(crate) fn try_whole_step(world: &mut World) -> bool {
         .and_then(|s| s.get(SubstepSchedule))
         .map_or(usize::MAX, Schedule::systems_len);
     let ran = total == own && !blocked(world) && (runner.0)(world);
-    if let Some(mut d) = world.get_resource_mut::<crate::PhysicsDiagnostics>() {
+    if let Some(mut d) = world.get_resource_mut::<crate::core::diagnostics::PhysicsDiagnostics>() {
         d.whole_step = ran;
     }
     ran

@@ -50,7 +50,7 @@ pub struct ForceSchedule;
 /// The sets of [`PhysicsSchedule`], in run order.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum PhysicsSystems {
-    /// Resources game code removed are re-created (see [`crate::restore`]).
+    /// Resources game code removed are re-created (see [`crate::core::restore`]).
     Restore,
     /// Derived data and bookkeeping before the substeps.
     Prepare,
@@ -155,7 +155,7 @@ pub enum RelaxSystems {
 pub enum PrepareSystems {
     /// Inputs and bookkeeping.
     Inputs,
-    /// Velocities game code wrote past the [`crate::DivergenceGuard`] are quarantined before
+    /// Velocities game code wrote past the [`crate::core::quarantine::DivergenceGuard`] are quarantined before
     /// the contacts use them.
     Guard,
     /// Islands fall asleep or wake.
@@ -315,7 +315,7 @@ pub(crate) fn init_schedules(world: &mut World) {
 
 /// How many of [`SubstepSchedule`]'s systems hooke's own plugins added. A schedule holding
 /// more has game systems in its substeps, which the whole-step path (see
-/// [`crate::whole_step`]) would skip.
+/// [`crate::core::whole_step`]) would skip.
 #[derive(Resource, Debug, Default)]
 pub(crate) struct OwnSubstepSystems(pub usize);
 

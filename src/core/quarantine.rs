@@ -3,7 +3,7 @@
 //!
 //! Two paths lead here:
 //! - **Bad input.** A component inserted directly with a non-finite or out-of-range value
-//!   (constructors can't be bypassed for [`crate::Mass`], but `Position(Vec3::NAN)` can be
+//!   (constructors can't be bypassed for [`crate::particles::Mass`], but `Position(Vec3::NAN)` can be
 //!   written by hand) is caught by the component's insert hook.
 //! - **Blow-up.** A body whose position or velocity is non-finite after integration.
 //! - **Runaway.** A body, or a node of a mesh, whose state is still finite but moving faster
@@ -14,14 +14,14 @@
 //!
 //! Either way the entity gets [`Quarantined`], every physics system skips it (an archetype
 //! filter, so it costs nothing per body), a [`BodyQuarantined`] message is written, and
-//! [`crate::PhysicsDiagnostics`] counts it. Remove [`Quarantined`] after repairing the state
+//! [`crate::core::diagnostics::PhysicsDiagnostics`] counts it. Remove [`Quarantined`] after repairing the state
 //! to put the body back.
 
 use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;
 use bevy_ecs::world::DeferredWorld;
 
-use crate::error::Error;
+use crate::core::error::Error;
 
 /// Why a body was taken out of the simulation.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -36,7 +36,7 @@ pub enum QuarantineReason {
     OutOfBounds {
         /// The largest coordinate (m).
         distance: f32,
-        /// The mesh node, for a [`crate::Nodes`] mesh.
+        /// The mesh node, for a [`crate::particles::Nodes`] mesh.
         node: Option<u32>,
     },
     /// Its speed (m/s) passed [`DivergenceGuard::max_speed`] while finite: the integration
@@ -44,7 +44,7 @@ pub enum QuarantineReason {
     Diverged {
         /// The speed found (m/s).
         speed: f32,
-        /// The mesh node, for a [`crate::Nodes`] mesh.
+        /// The mesh node, for a [`crate::particles::Nodes`] mesh.
         node: Option<u32>,
     },
     /// The collision geometry library failed (panicked) on its pair with `other`: a shape at
@@ -104,7 +104,7 @@ pub struct DivergenceGuard {
     /// stretched to 101 times its rest length). Zero-length springs are not checked.
     pub max_spring_strain: f32,
     /// Distance from the origin along any axis beyond any game world's (m; default 1e6,
-    /// [`crate::Collider::MAX_EXTENT`]: f32 resolves positions there to 6 cm). The fuzzer found
+    /// [`crate::collision::Collider::MAX_EXTENT`]: f32 resolves positions there to 6 cm). The fuzzer found
     /// a body flung to 2e8 m within one step at a speed the step's last pass had undone.
     #[serde(default = "far")]
     pub max_distance: f32,
@@ -183,7 +183,7 @@ impl DivergenceGuard {
 
 /// Errors go into snapshots as their message: several variants hold `&'static str` names.
 mod error_text {
-    use crate::error::Error;
+    use crate::core::error::Error;
 
     pub(super) fn serialize<S: serde::Serializer>(e: &Error, s: S) -> Result<S::Ok, S::Error> {
         match e {
@@ -280,37 +280,13 @@ pub(crate) fn validate_changed<T: Component + Validate>(
     }
 }
 
-/// A velocity past the guard (game code set a crate to 1e30 m/s) is caught before the step
-/// uses it: the contacts run before the integrators' own check, and a runaway's sweep box
-/// covers the world, so in that one step it flung bodies 30 m away to 1e27 m (found by the
-/// scenario corpus, `scenarios/quarantine_caught.ron`). One compare per moved body.
-pub(crate) fn quarantine_runaway_velocities(
-    mut commands: Commands,
-    guard: Option<Res<DivergenceGuard>>,
-    moved: Query<
-        (
-            Entity,
-            &crate::particles::Position,
-            &crate::particles::LinearVelocity,
-        ),
-        ChangedLive<crate::particles::LinearVelocity>,
-    >,
-) {
-    let guard = guard.map_or_else(DivergenceGuard::default, |g| *g);
-    for (e, x, v) in &moved {
-        if let Some(reason) = guard.check(x.0, v.0, None) {
-            commands.entity(e).try_insert(Quarantined { reason });
-        }
-    }
-}
-
 /// Adds [`validate_changed`] for `T` to the step (effects call it for their cold components).
 pub(crate) fn validate_writes<T: Component + Validate>(world: &mut World) {
-    crate::schedule::add_own_systems(
+    crate::core::schedule::add_own_systems(
         world,
-        crate::schedule::PhysicsSchedule,
+        crate::core::schedule::PhysicsSchedule,
         validate_changed::<T>
             .run_if(any_with_component::<T>)
-            .in_set(crate::schedule::PrepareSystems::Inputs),
+            .in_set(crate::core::schedule::PrepareSystems::Inputs),
     );
 }
