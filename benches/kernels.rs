@@ -10,7 +10,8 @@ mod timing;
 use std::hint::black_box;
 
 use glam::Vec3A;
-use hooke::integrator::{Rk4Scratch, advect_euler, advect_rk4, drift, kick};
+use hooke::integrator::{Rk4Scratch, drift, kick};
+use hooke::particles::fields::{advect_euler, advect_rk4};
 use hooke::scenes::jitter;
 use hooke::springs::spring_force;
 use timing::{Config, compare, line};

@@ -45,7 +45,7 @@
 //! # }
 //! ```
 //!
-//! Every setting's world is a fresh `World` with [`crate::PhysicsPlugins`], a
+//! Every setting's world is a fresh `World` with [`crate::plugins::PhysicsPlugins`], a
 //! [`PhysicsTime`] of [`Sweep::dt`] split into the setting's substeps, and the setting's
 //! [`Integrator`] resource; `build` adds the scene (and may change any resource, gravity
 //! included). A run that turns non-finite, or whose bodies are quarantined, reports
@@ -55,12 +55,12 @@ use std::time::{Duration, Instant};
 
 use bevy_ecs::prelude::*;
 
-use crate::PhysicsPlugins;
-use crate::PhysicsWorldExt;
 use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::error::{Error, Result};
 use crate::core::time::PhysicsTime;
 use crate::integrator::Integrator;
+use crate::plugins::PhysicsPlugins;
+use crate::plugins::PhysicsWorldExt;
 
 /// One point on the dial: an integrator and the substeps per fixed step.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

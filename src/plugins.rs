@@ -48,7 +48,7 @@ pub trait PhysicsWorldExt {
     /// [`PhysicsTime::max_steps_per_frame`](crate::core::time::PhysicsTime::max_steps_per_frame).
     ///
     /// # Errors
-    /// [`crate::Error::InvalidTimeStep`] for a negative or non-finite `frame_dt` (nothing
+    /// [`crate::core::error::Error::InvalidTimeStep`] for a negative or non-finite `frame_dt` (nothing
     /// runs).
     fn advance_physics(&mut self, frame_dt: f32) -> Result<FrameReport>;
 }

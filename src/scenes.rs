@@ -4,13 +4,13 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 
-use crate::PhysicsPlugins;
-use crate::PhysicsWorldExt;
 use crate::cloth::ClothBuilder;
 use crate::core::error::Result;
 use crate::core::time::PhysicsTime;
 use crate::integrator::Integrator;
 use crate::particles::{Gravity, ParticleBundle, Tracer, VelocityField};
+use crate::plugins::PhysicsPlugins;
+use crate::plugins::PhysicsWorldExt;
 use crate::springs::{Chain, ChainBuilder, Spring};
 
 /// A world with every plugin, the given step and integrator, and gravity `g`.
@@ -497,7 +497,7 @@ pub fn squeeze_densities(ratio: f32) -> [f32; 4] {
 /// bottom one.
 ///
 /// # Errors
-/// [`crate::Error::NotPositive`] or [`crate::Error::NonFinite`] for a bad `ratio`.
+/// [`crate::core::error::Error::NotPositive`] or [`crate::core::error::Error::NonFinite`] for a bad `ratio`.
 pub fn squeeze(world: &mut World, ratio: f32) -> Result<[Entity; 3]> {
     crate::core::error::positive("mass ratio", ratio)?;
     let rho = squeeze_densities(ratio);

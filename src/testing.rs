@@ -23,10 +23,10 @@
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 
-use crate::PhysicsWorldExt;
 use crate::core::error::{Error, Result};
 use crate::core::time::PhysicsTime;
 use crate::particles::{LinearVelocity, Position};
+use crate::plugins::PhysicsWorldExt;
 use crate::rigid::{AngularVelocity, Rotation};
 
 /// Running a physics world headless, and reading its bodies (implemented for [`World`]).

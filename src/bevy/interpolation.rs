@@ -15,7 +15,7 @@ use bevy_time::{Fixed, Time};
 use bevy_transform::components::Transform;
 use glam::{Quat, Vec3};
 
-use super::transform::SyncedTransform;
+use super::SyncedTransform;
 use crate::particles::LinearVelocity;
 use crate::rigid::AngularVelocity;
 

@@ -53,7 +53,7 @@ pub use diagnostics::PhysicsDiagnosticsPlugin;
 pub use interpolation::{
     PhysicsInterpolationPlugin, PoseHistory, TransformExtrapolation, TransformInterpolation,
 };
-pub use transform::{PhysicsTransformPlugin, SyncedTransform};
+pub use transform::PhysicsTransformPlugin;
 
 use bevy_app::{App, FixedPostUpdate, Plugin, PluginGroup, PluginGroupBuilder};
 use bevy_ecs::intern::Interned;
@@ -61,9 +61,9 @@ use bevy_ecs::message::MessageRegistry;
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::ScheduleLabel;
 use bevy_time::{Fixed, Time};
+use bevy_transform::components::Transform;
+use glam::{Quat, Vec3};
 
-use crate::PhysicsPlugins;
-use crate::PhysicsWorldExt;
 use crate::cloth::ClothPlugin;
 use crate::collision::CollisionPlugin;
 use crate::collision::ContactEnded;
@@ -74,6 +74,8 @@ use crate::core::time::PhysicsTime;
 use crate::particles::DampingPlugin;
 use crate::particles::GravityPlugin;
 use crate::particles::VelocityFieldPlugin;
+use crate::plugins::PhysicsPlugins;
+use crate::plugins::PhysicsWorldExt;
 use crate::rigid::RigidBodyPlugin;
 use crate::sleep::SleepPlugin;
 use crate::soft::SoftBodyPlugin;
@@ -227,5 +229,25 @@ impl PluginGroup for PhysicsPlugins {
             .add(ClothPlugin)
             .add(PhysicsTransformPlugin)
             .add(PhysicsInterpolationPlugin)
+    }
+}
+
+/// The `Transform` hooke last wrote or read for this entity. Added by hooke.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+pub struct SyncedTransform {
+    translation: Vec3,
+    rotation: Quat,
+}
+
+impl SyncedTransform {
+    pub(crate) fn of(t: &Transform) -> Self {
+        Self {
+            translation: t.translation,
+            rotation: t.rotation,
+        }
+    }
+
+    pub(crate) fn matches(&self, t: &Transform) -> bool {
+        self.translation == t.translation && self.rotation == t.rotation
     }
 }

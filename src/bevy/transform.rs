@@ -18,6 +18,7 @@ use bevy_ecs::prelude::*;
 use bevy_transform::components::{GlobalTransform, Transform};
 use glam::{Quat, Vec3, Vec3A};
 
+use super::SyncedTransform;
 use super::interpolation::PoseHistory;
 use super::{AppSchedule, PhysicsAppSystems};
 use crate::collision::{Collider, ColliderOf, ColliderOffset};
@@ -43,26 +44,6 @@ impl Plugin for PhysicsTransformPlugin {
             ),
         );
         app.add_observer(place_on_spawn);
-    }
-}
-
-/// The `Transform` hooke last wrote or read for this entity. Added by hooke.
-#[derive(Component, Debug, Clone, Copy, PartialEq)]
-pub struct SyncedTransform {
-    translation: Vec3,
-    rotation: Quat,
-}
-
-impl SyncedTransform {
-    pub(super) fn of(t: &Transform) -> Self {
-        Self {
-            translation: t.translation,
-            rotation: t.rotation,
-        }
-    }
-
-    fn matches(&self, t: &Transform) -> bool {
-        self.translation == t.translation && self.rotation == t.rotation
     }
 }
 

@@ -4,7 +4,7 @@ use bevy_ecs::prelude::*;
 use glam::Vec3A;
 
 use super::Cloth;
-use crate::Error;
+use crate::core::error::Error;
 use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::{QuarantineReason, Quarantined};
 use crate::core::schedule::{

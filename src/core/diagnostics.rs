@@ -8,23 +8,24 @@
 //! - spring U_s = Σ ½ k (l − r)²;
 //! - linear momentum P = Σ m v.
 //!
-//! The energy pass reads every body once per step; turn it off with
+//! The kernel measures timings and counts quarantined bodies; each effect measures what it
+//! owns in [`MeasureSystems`] (the integrators: motion, momentum and gravity; springs: their
+//! elastic energy; soft bodies: theirs). The energy pass reads every body once per step; turn it off with
 //! [`DiagnosticsSettings::energy`] when a scene is too large to afford it. Timings per set
 //! are summed over the substeps of the last step.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use bevy_platform::time::Instant;
 
 use bevy_ecs::prelude::*;
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 
 use crate::core::quarantine::{QuarantineReason, Quarantined};
 use crate::core::schedule::{
-    FinishSystems, PhysicsSchedule, PhysicsSystems, ProbeSystems, StepSystems, SubstepSchedule,
-    add_own_systems,
+    FinishSystems, MeasureSystems, PhysicsSchedule, PhysicsSystems, ProbeSystems, StepSystems,
+    SubstepSchedule, add_own_systems,
 };
-use crate::particles::{Gravity, LinearVelocity, Mass, Nodes, Position, Tracer};
-use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, rotational_energy};
-use crate::springs::{Endpoint, Spinning, Spring, SpringNetwork, anchor_state, spring_energy};
 
 /// How many things of each kind the world holds (quarantined ones counted apart).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -159,12 +160,11 @@ pub(crate) fn install(world: &mut World) {
             reset_clock
                 .run_if(timings_on)
                 .in_set(PhysicsSystems::Prepare),
-            (
-                publish_timings.run_if(timings_on),
-                measure_energy.run_if(|s: Res<DiagnosticsSettings>| s.energy),
-            )
-                .chain()
-                .in_set(FinishSystems::Diagnostics),
+            publish_timings
+                .run_if(timings_on)
+                .in_set(FinishSystems::Diagnostics)
+                .before(MeasureSystems),
+            MeasureSystems::configure(count_quarantined.run_if(energy_on)),
         ),
     );
 }
@@ -186,6 +186,12 @@ fn timings_on(s: Res<DiagnosticsSettings>) -> bool {
     s.timings
 }
 
+/// Whether energies, momenta and counts are measured this step: the run condition of every
+/// effect's measurement.
+pub fn energy_on(s: Res<DiagnosticsSettings>) -> bool {
+    s.energy
+}
+
 fn reset_clock(mut clock: ResMut<SetClock>) {
     *clock = SetClock::default();
 }
@@ -194,82 +200,10 @@ fn publish_timings(clock: Res<SetClock>, mut diag: ResMut<PhysicsDiagnostics>) {
     diag.set_times = clock.acc;
 }
 
-type Live = Without<Quarantined>;
-
-#[allow(clippy::too_many_arguments)]
-fn measure_energy(
+/// The kernel's own count: bodies in quarantine.
+fn count_quarantined(
     mut diag: ResMut<PhysicsDiagnostics>,
-    gravity: Option<Res<Gravity>>,
-    bodies: Query<(&Position, &LinearVelocity, &Mass), Live>,
-    meshes: Query<(&Nodes, Option<&SpringNetwork>), Live>,
-    springs: Query<&Spring, Live>,
-    states: Query<Endpoint, Live>,
-    spinning: Query<Spinning, Live>,
-    rotating: Query<(&AngularVelocity, &AngularMomentum, &Inertia), Live>,
-    tracers: Query<(), (With<Tracer>, Live)>,
     quarantined: Query<(), With<Quarantined>>,
 ) {
-    let g = gravity.map_or(DVec3::ZERO, |g| g.get().as_dvec3());
-    let (mut t, mut u, mut us, mut p) = (0.0f64, 0.0f64, 0.0f64, DVec3::ZERO);
-    let mut counts = BodyCounts::default();
-    for (x, v, m) in &bodies {
-        counts.particles += 1;
-        if m.is_pinned() {
-            continue;
-        }
-        let (mass, v) = (f64::from(m.value()), v.0.as_dvec3());
-        t += 0.5 * mass * v.length_squared();
-        u -= mass * g.dot(x.0.as_dvec3());
-        p += mass * v;
-    }
-    for (nodes, net) in &meshes {
-        counts.meshes += 1;
-        counts.mesh_nodes += nodes.len();
-        for i in 0..nodes.len() {
-            let mass = f64::from(nodes.mass[i]);
-            let v = Vec3::from(nodes.v[i]).as_dvec3();
-            t += 0.5 * mass * v.length_squared();
-            u -= mass * g.dot(Vec3::from(nodes.x[i]).as_dvec3());
-            p += mass * v;
-        }
-        if let Some(net) = net {
-            counts.mesh_springs += net.len();
-            us += net.energy(nodes);
-        }
-    }
-    for s in &springs {
-        counts.springs += 1;
-        if let (Ok(a), Ok(b)) = (states.get(s.a()), states.get(s.b())) {
-            let (anchor_a, anchor_b) = s.anchors();
-            let (pa, _, _) = anchor_state(a, spinning.get(s.a()).ok(), anchor_a);
-            let (pb, _, _) = anchor_state(b, spinning.get(s.b()).ok(), anchor_b);
-            us += spring_energy(pa, pb, s.rest_length(), s.stiffness());
-        }
-    }
-    // Rotation: T_rot = ½ ω·L; angular momentum about the origin Σ (x × m v) + L.
-    let mut t_rot = 0.0f64;
-    let mut l_total = DVec3::ZERO;
-    for (x, v, m) in &bodies {
-        if !m.is_pinned() {
-            l_total += Vec3::from(x.0)
-                .as_dvec3()
-                .cross(f64::from(m.value()) * Vec3::from(v.0).as_dvec3());
-        }
-    }
-    for (w, l, inertia) in &rotating {
-        if !inertia.is_infinite() {
-            t_rot += rotational_energy(w.0, l.0);
-            l_total += Vec3::from(l.0).as_dvec3();
-        }
-    }
-    counts.rigid_bodies = rotating.iter().count();
-    counts.tracers = tracers.iter().count();
-    counts.quarantined = quarantined.iter().count();
-    diag.kinetic_energy = t + t_rot;
-    diag.rotational_energy = t_rot;
-    diag.angular_momentum = l_total.as_vec3();
-    diag.gravitational_energy = u;
-    diag.spring_energy = us;
-    diag.linear_momentum = p.as_vec3();
-    diag.counts = counts;
+    diag.counts.quarantined = quarantined.iter().count();
 }

@@ -14,8 +14,9 @@ use bevy_platform::time::Instant;
 use super::diagnostics::PhysicsDiagnostics;
 use super::quarantine::{BodyQuarantined, DivergenceGuard};
 use super::restore::{self, InvalidSetting, ResourceRestored};
+use super::schedule::SubstepSchedule;
 use super::schedule::{self, PhysicsSchedule, PhysicsSystems};
-use super::time::{self, FrameReport, PhysicsTime, SubstepTime};
+use super::time::{FrameReport, PhysicsTime, SubstepTime};
 use super::whole_step::FusedSubsteps;
 use super::{diagnostics, error::Result};
 
@@ -62,7 +63,7 @@ impl WorldPlugin for PhysicsCorePlugin {
         schedule::add_own_systems(
             world,
             PhysicsSchedule,
-            time::run_substeps.in_set(PhysicsSystems::Step),
+            run_substeps.in_set(PhysicsSystems::Step),
         );
         diagnostics::install(world);
     }
@@ -120,6 +121,44 @@ pub(crate) fn anything_moves(world: &World) -> bool {
                 .any(|&a| !world.archetypes()[a].is_empty())
         })
     })
+}
+
+/// Runs the substep schedule `substeps` times. The only system in `PhysicsSystems::Step`.
+/// A world where nothing registered as moving ([`crate::core::plugin::moves`]) exists only
+/// advances its clock.
+fn run_substeps(world: &mut World) {
+    if !world.contains_resource::<PhysicsTime>() {
+        return;
+    }
+    let empty = !anything_moves(world);
+    // An effect that ran the whole step leaves only the clock to advance.
+    let done = empty || crate::core::whole_step::try_whole_step(world);
+    let Some(time) = world.get_resource::<PhysicsTime>() else {
+        return;
+    };
+    let (n, h, t0) = (time.substeps(), time.substep_dt(), time.elapsed());
+    // One lookup of the schedule for all substeps. The core plugin creates it; a missing
+    // one means a user removed it, and the step then does nothing.
+    let _ = world.try_schedule_scope(SubstepSchedule, |world, schedule| {
+        if done {
+            return;
+        }
+        for i in 0..n {
+            let t = (t0 + f64::from(h) * f64::from(i)) as f32;
+            // Inserted, not written through: a system of the substep may have removed it.
+            world.insert_resource(SubstepTime {
+                h,
+                t,
+                index: i,
+                count: n,
+            });
+
+            schedule.run(world);
+        }
+    });
+    if let Some(mut time) = world.get_resource_mut::<PhysicsTime>() {
+        time.end_step();
+    }
 }
 
 fn rotate_messages(world: &mut World) {

@@ -31,11 +31,12 @@
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::schedule::{
-    IntoScheduleConfigs, LogLevel, ScheduleBuildSettings, ScheduleLabel, SingleThreadedExecutor,
+    IntoScheduleConfigs, LogLevel, ScheduleBuildSettings, ScheduleConfigs, ScheduleLabel,
+    SingleThreadedExecutor,
 };
 use bevy_ecs::system::ScheduleSystem;
 
-/// One fixed physics step. Run it with [`crate::PhysicsWorldExt::step_physics`].
+/// One fixed physics step. Run it with [`crate::plugins::PhysicsWorldExt::step_physics`].
 #[derive(ScheduleLabel, Debug, Clone, PartialEq, Eq, Hash)]
 pub struct PhysicsSchedule;
 
@@ -187,6 +188,22 @@ pub enum FinishSystems {
     Diagnostics,
 }
 
+/// Where each effect measures its own energy, momentum and counts into
+/// [`crate::core::diagnostics::PhysicsDiagnostics`], inside [`FinishSystems::Diagnostics`]
+/// after the kernel's timings. Each effect writes fields of its own, so these systems may run
+/// in any order among themselves: add them with [`MeasureSystems::configure`].
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct MeasureSystems;
+
+impl MeasureSystems {
+    /// `system` in this set, declared free of order among the other measurements.
+    pub fn configure<M>(
+        system: impl IntoScheduleConfigs<ScheduleSystem, M>,
+    ) -> ScheduleConfigs<ScheduleSystem> {
+        system.in_set(MeasureSystems).ambiguous_with(MeasureSystems)
+    }
+}
+
 /// Timing probes between the step sets; probe k runs just before `StepSystems::ORDER[k]`.
 #[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub(crate) struct ProbeSystems(pub u8);
@@ -241,6 +258,7 @@ pub(crate) fn init_schedules(world: &mut World) {
             .chain()
             .in_set(PhysicsSystems::Finish),
     );
+    physics.configure_sets(MeasureSystems.in_set(FinishSystems::Diagnostics));
 
     let mut substep = new_schedule(SubstepSchedule, false);
     substep.configure_sets(

@@ -2,14 +2,13 @@
 //!
 //! A physics step has a fixed length `dt` (s) split into `substeps` substeps of length
 //! h = dt / substeps. A game's frames have whatever length they have: [`PhysicsTime`] keeps an
-//! accumulator, and [`crate::PhysicsWorldExt::advance_physics`] runs as many whole steps as
+//! accumulator, and [`crate::plugins::PhysicsWorldExt::advance_physics`] runs as many whole steps as
 //! fit, at most `max_steps_per_frame`, so that one slow frame cannot make the next one slower
 //! still (the "spiral of death"). Time beyond the cap is dropped and reported.
 
 use bevy_ecs::prelude::*;
 
 use crate::core::error::{Error, Result};
-use crate::core::schedule::SubstepSchedule;
 
 /// The fixed step and the simulation clock.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone)]
@@ -98,6 +97,12 @@ impl PhysicsTime {
         self.elapsed
     }
 
+    /// Advances the clock by one step of `dt`.
+    pub(crate) fn end_step(&mut self) {
+        self.elapsed += f64::from(self.dt);
+        self.steps += 1;
+    }
+
     /// Whole steps taken.
     #[must_use]
     pub fn steps(&self) -> u64 {
@@ -180,45 +185,6 @@ pub struct FrameReport {
     pub steps: u32,
     /// Frame time thrown away because the step cap was reached (s).
     pub dropped: f32,
-}
-
-/// Runs the substep schedule `substeps` times. The only system in `PhysicsSystems::Step`.
-/// A world where nothing registered as moving ([`crate::core::plugin::moves`]) exists only
-/// advances its clock.
-pub(crate) fn run_substeps(world: &mut World) {
-    if !world.contains_resource::<PhysicsTime>() {
-        return;
-    }
-    let empty = !crate::core::plugin::anything_moves(world);
-    // An effect that ran the whole step leaves only the clock to advance.
-    let done = empty || crate::core::whole_step::try_whole_step(world);
-    let Some(time) = world.get_resource::<PhysicsTime>() else {
-        return;
-    };
-    let (n, h, t0) = (time.substeps, time.substep_dt(), time.elapsed);
-    // One lookup of the schedule for all substeps. The core plugin creates it; a missing
-    // one means a user removed it, and the step then does nothing.
-    let _ = world.try_schedule_scope(SubstepSchedule, |world, schedule| {
-        if done {
-            return;
-        }
-        for i in 0..n {
-            let t = (t0 + f64::from(h) * f64::from(i)) as f32;
-            // Inserted, not written through: a system of the substep may have removed it.
-            world.insert_resource(SubstepTime {
-                h,
-                t,
-                index: i,
-                count: n,
-            });
-
-            schedule.run(world);
-        }
-    });
-    if let Some(mut time) = world.get_resource_mut::<PhysicsTime>() {
-        time.elapsed += f64::from(time.dt);
-        time.steps += 1;
-    }
 }
 
 #[cfg(test)]

@@ -32,13 +32,15 @@
 //! t = 0.3 s for a 1 s period).
 
 pub(crate) mod implicit;
+mod measure;
 mod plugin;
+mod rotation;
 pub(crate) mod skyline;
 mod stages;
 
 pub use implicit::ImplicitReport;
+pub(crate) use plugin::constant_force;
 pub use plugin::{ConstraintsActive, IntegratorPlugin};
-pub(crate) use plugin::{constant_force, mesh_divergence};
 
 /// Meshes the explicit integrators advance: alive, awake, and not solved implicitly.
 pub(crate) type ExplicitMesh = (
@@ -50,6 +52,9 @@ pub use stages::{AngularRk4, Rk4Scratch};
 
 use bevy_ecs::prelude::*;
 use glam::Vec3A;
+
+use crate::core::quarantine::{DivergenceGuard, QuarantineReason};
+use crate::particles::Nodes;
 
 /// Which time integrator advances bodies. A resource (the default for every body) and, through
 /// [`IntegratorOverride`], a per-body choice.
@@ -284,27 +289,31 @@ pub fn drift(x: Vec3A, v: Vec3A, h: f32) -> Vec3A {
     x + h * v
 }
 
-/// Lecture's Euler advection through a velocity field: x ← x + h u(x, t).
+/// Why a finite mesh counts as diverged: its farthest node left the world, or its fastest
+/// node is past the guard.
 #[must_use]
-pub fn advect_euler(x: Vec3A, t: f32, h: f32, u: impl Fn(Vec3A, f32) -> Vec3A) -> Vec3A {
-    x + h * u(x, t)
-}
-
-/// Midpoint (RK2) advection: second order.
-#[must_use]
-pub fn advect_midpoint(x: Vec3A, t: f32, h: f32, u: impl Fn(Vec3A, f32) -> Vec3A) -> Vec3A {
-    let k1 = u(x, t);
-    x + h * u(x + 0.5 * h * k1, t + 0.5 * h)
-}
-
-/// Classic RK4 advection: fourth order.
-#[must_use]
-pub fn advect_rk4(x: Vec3A, t: f32, h: f32, u: impl Fn(Vec3A, f32) -> Vec3A) -> Vec3A {
-    let k1 = u(x, t);
-    let k2 = u(x + 0.5 * h * k1, t + 0.5 * h);
-    let k3 = u(x + 0.5 * h * k2, t + 0.5 * h);
-    let k4 = u(x + h * k3, t + h);
-    x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+pub(crate) fn mesh_divergence(n: &Nodes, guard: &DivergenceGuard) -> Option<QuarantineReason> {
+    let (far, distance) =
+        n.x.iter()
+            .enumerate()
+            .fold((0, 0.0f32), |(bi, bd), (i, x)| {
+                let d = x.abs().max_element();
+                if d > bd { (i, d) } else { (bi, bd) }
+            });
+    if distance > guard.max_distance {
+        return Some(QuarantineReason::OutOfBounds {
+            distance,
+            node: Some(far as u32),
+        });
+    }
+    let (i, _) =
+        n.v.iter()
+            .enumerate()
+            .fold((0, 0.0f32), |(bi, bs), (i, v)| {
+                let s = v.length_squared();
+                if s > bs { (i, s) } else { (bi, bs) }
+            });
+    guard.check(glam::Vec3A::ZERO, *n.v.get(i)?, Some(i as u32))
 }
 
 #[cfg(test)]
@@ -318,14 +327,5 @@ mod tests {
         assert_eq!(x, 0.25 * Vec3A::X);
         let (x, _) = explicit_euler(Vec3A::ZERO, Vec3A::ZERO, Vec3A::X, 0.5);
         assert_eq!(x, Vec3A::ZERO);
-    }
-
-    #[test]
-    fn rk4_advection_is_exact_for_cubic_in_time() {
-        // dx/dt = 3t²: RK4 integrates polynomials up to degree 3 in t exactly.
-        let x = advect_rk4(Vec3A::ZERO, 0.0, 1.0, |_, t| Vec3A::splat(3.0 * t * t));
-        assert!((x.x - 1.0).abs() < 1e-6);
-        let x = advect_euler(Vec3A::ZERO, 0.0, 1.0, |_, t| Vec3A::splat(3.0 * t * t));
-        assert_eq!(x.x, 0.0);
     }
 }

@@ -3,14 +3,13 @@
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 
-use super::{Integrator, IntegratorOverride, drift, explicit_euler, kick};
+use super::{Integrator, IntegratorOverride, drift, explicit_euler, kick, mesh_divergence};
+use crate::core::diagnostics::energy_on;
 use crate::core::plugin::WorldPlugin;
-use crate::core::quarantine::{
-    DivergenceGuard, QuarantineReason, Quarantined, quarantine_non_finite,
-};
+use crate::core::quarantine::{DivergenceGuard, Quarantined, quarantine_non_finite};
 use crate::core::schedule::{
-    IntegrationSystems, PhysicsSchedule, PrepareSystems, StepSystems, SubstepSchedule,
-    add_own_force_systems, add_own_systems,
+    IntegrationSystems, MeasureSystems, PhysicsSchedule, PrepareSystems, StepSystems,
+    SubstepSchedule, add_own_force_systems, add_own_systems,
 };
 use crate::core::time::SubstepTime;
 use crate::particles::{
@@ -59,6 +58,11 @@ impl WorldPlugin for IntegratorPlugin {
             PhysicsSchedule,
             quarantine_runaway_velocities.in_set(PrepareSystems::Guard),
         );
+        add_own_systems(
+            world,
+            PhysicsSchedule,
+            MeasureSystems::configure(super::measure::measure_motion.run_if(energy_on)),
+        );
         add_own_force_systems(world, || clear_forces.in_set(StepSystems::ClearForces));
         add_own_systems(
             world,
@@ -71,7 +75,13 @@ impl WorldPlugin for IntegratorPlugin {
                     )
                     .in_set(IntegrationSystems::Impulses),
                 integrate_velocities.in_set(IntegrationSystems::Integrate),
+                super::rotation::integrate_angular_momenta
+                    .run_if(any_with_component::<Inertia>)
+                    .in_set(IntegrationSystems::Integrate),
                 integrate_positions.in_set(StepSystems::IntegratePositions),
+                super::rotation::integrate_orientations
+                    .run_if(any_with_component::<Inertia>)
+                    .in_set(StepSystems::IntegratePositions),
                 super::stages::complete_stages
                     .run_if(super::stages::needs_stages)
                     .in_set(StepSystems::CompleteStages),
@@ -327,33 +337,6 @@ fn check_mesh(commands: &mut Commands, e: Entity, n: &Nodes, guard: &DivergenceG
     } else if let Some(reason) = mesh_divergence(n, guard) {
         commands.entity(e).insert(Quarantined { reason });
     }
-}
-
-/// Why a finite mesh counts as diverged: its farthest node left the world, or its fastest
-/// node is past the guard.
-#[must_use]
-pub(crate) fn mesh_divergence(n: &Nodes, guard: &DivergenceGuard) -> Option<QuarantineReason> {
-    let (far, distance) =
-        n.x.iter()
-            .enumerate()
-            .fold((0, 0.0f32), |(bi, bd), (i, x)| {
-                let d = x.abs().max_element();
-                if d > bd { (i, d) } else { (bi, bd) }
-            });
-    if distance > guard.max_distance {
-        return Some(QuarantineReason::OutOfBounds {
-            distance,
-            node: Some(far as u32),
-        });
-    }
-    let (i, _) =
-        n.v.iter()
-            .enumerate()
-            .fold((0, 0.0f32), |(bi, bs), (i, v)| {
-                let s = v.length_squared();
-                if s > bs { (i, s) } else { (bi, bs) }
-            });
-    guard.check(glam::Vec3A::ZERO, *n.v.get(i)?, Some(i as u32))
 }
 
 #[allow(clippy::type_complexity)] // a ParamSet of queries; naming each adds nothing

@@ -302,7 +302,7 @@ pub(crate) fn complete_stages(
         {
             if !nodes.is_finite() {
                 bad.push((*e, QuarantineReason::NonFiniteState));
-            } else if let Some(reason) = super::plugin::mesh_divergence(nodes, &guard) {
+            } else if let Some(reason) = super::mesh_divergence(nodes, &guard) {
                 bad.push((*e, reason));
             }
         }

@@ -36,7 +36,7 @@ impl Gravity {
     /// Gravity `g` (m/s²).
     ///
     /// # Errors
-    /// [`crate::Error::NonFinite`].
+    /// [`crate::core::error::Error::NonFinite`].
     pub fn new(g: Vec3) -> Result<Self> {
         finite_vec("gravity", g).map(Self)
     }
@@ -100,7 +100,7 @@ impl VelocityField {
     /// A uniform field.
     ///
     /// # Errors
-    /// [`crate::Error::NonFinite`].
+    /// [`crate::core::error::Error::NonFinite`].
     pub fn uniform(u: Vec3) -> Result<Self> {
         finite_vec("field velocity", u).map(Self::Uniform)
     }
@@ -108,7 +108,7 @@ impl VelocityField {
     /// A vortex about `axis` (normalised here) through `center`, turning at `rate` rad/s.
     ///
     /// # Errors
-    /// [`crate::Error::NonFinite`] for non-finite input, [`crate::Error::NotPositive`] (the
+    /// [`crate::core::error::Error::NonFinite`] for non-finite input, [`crate::core::error::Error::NotPositive`] (the
     /// axis length) for a zero axis.
     pub fn vortex(center: Vec3, axis: Vec3, rate: f32) -> Result<Self> {
         let center = finite_vec("vortex center", center)?;
@@ -119,7 +119,7 @@ impl VelocityField {
         let big = axis.abs().max_element();
         let axis = (axis / big)
             .try_normalize()
-            .ok_or(crate::Error::NotPositive {
+            .ok_or(crate::core::error::Error::NotPositive {
                 what: "vortex axis length",
                 value: axis.length(),
             })?;
@@ -144,5 +144,42 @@ impl VelocityField {
             Self::Vortex { center, omega } => Vec3A::from(*omega).cross(x - Vec3A::from(*center)),
             Self::Custom(u) => u(x.into(), t).into(),
         }
+    }
+}
+
+/// Lecture's Euler advection through a velocity field: x ← x + h u(x, t).
+#[must_use]
+pub fn advect_euler(x: Vec3A, t: f32, h: f32, u: impl Fn(Vec3A, f32) -> Vec3A) -> Vec3A {
+    x + h * u(x, t)
+}
+
+/// Midpoint (RK2) advection: second order.
+#[must_use]
+pub fn advect_midpoint(x: Vec3A, t: f32, h: f32, u: impl Fn(Vec3A, f32) -> Vec3A) -> Vec3A {
+    let k1 = u(x, t);
+    x + h * u(x + 0.5 * h * k1, t + 0.5 * h)
+}
+
+/// Classic RK4 advection: fourth order.
+#[must_use]
+pub fn advect_rk4(x: Vec3A, t: f32, h: f32, u: impl Fn(Vec3A, f32) -> Vec3A) -> Vec3A {
+    let k1 = u(x, t);
+    let k2 = u(x + 0.5 * h * k1, t + 0.5 * h);
+    let k3 = u(x + 0.5 * h * k2, t + 0.5 * h);
+    let k4 = u(x + h * k3, t + h);
+    x + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rk4_advection_is_exact_for_cubic_in_time() {
+        // dx/dt = 3t²: RK4 integrates polynomials up to degree 3 in t exactly.
+        let x = advect_rk4(Vec3A::ZERO, 0.0, 1.0, |_, t| Vec3A::splat(3.0 * t * t));
+        assert!((x.x - 1.0).abs() < 1e-6);
+        let x = advect_euler(Vec3A::ZERO, 0.0, 1.0, |_, t| Vec3A::splat(3.0 * t * t));
+        assert_eq!(x.x, 0.0);
     }
 }

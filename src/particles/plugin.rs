@@ -4,6 +4,7 @@ use bevy_ecs::prelude::*;
 use glam::Vec3A;
 
 use super::fields::{Advection, Gravity, VelocityField};
+use super::fields::{advect_euler, advect_midpoint, advect_rk4};
 use super::{Force, LinearDamping, LinearVelocity, Mass, Position, Tracer};
 use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::{Quarantined, quarantine_non_finite};
@@ -11,7 +12,6 @@ use crate::core::schedule::{
     ForceSystems, StepSystems, SubstepSchedule, add_own_force_systems, add_own_systems,
 };
 use crate::core::time::SubstepTime;
-use crate::integrator::{advect_euler, advect_midpoint, advect_rk4};
 
 /// Bodies the step moves: not quarantined, not asleep.
 type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);

@@ -1,4 +1,5 @@
-//! Rigid-body systems: the angular half of each integrator, torques, renormalisation.
+//! Rigid-body systems: user inputs, torques, renormalisation. The angular half of each
+//! integrator is the integrators' (`integrator::rotation`).
 
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3A};
@@ -9,13 +10,12 @@ use super::{
     free_rotation_split, integrate_rotation, omega_of, world_point,
 };
 use crate::core::plugin::WorldPlugin;
-use crate::core::quarantine::{Quarantined, quarantine_non_finite};
+use crate::core::quarantine::Quarantined;
 use crate::core::schedule::{
-    ForceSystems, IntegrationSystems, PhysicsSchedule, PrepareSystems, StepSystems,
-    SubstepSchedule, add_own_force_systems, add_own_systems,
+    ForceSystems, PhysicsSchedule, PrepareSystems, StepSystems, SubstepSchedule,
+    add_own_force_systems, add_own_systems,
 };
-use crate::core::time::{PhysicsTime, SubstepTime};
-use crate::integrator::{Integrator, IntegratorOverride};
+use crate::core::time::PhysicsTime;
 use crate::particles::{Force, LinearVelocity, Position};
 
 /// Bodies the step moves: not quarantined, not asleep.
@@ -63,17 +63,9 @@ impl WorldPlugin for RigidBodyPlugin {
         add_own_systems(
             world,
             SubstepSchedule,
-            (
-                integrate_angular_momenta
-                    .run_if(any_with_component::<Inertia>)
-                    .in_set(IntegrationSystems::Integrate),
-                integrate_orientations
-                    .run_if(any_with_component::<Inertia>)
-                    .in_set(StepSystems::IntegratePositions),
-                renormalize_rotations
-                    .run_if(any_with_component::<Inertia>)
-                    .in_set(StepSystems::Renormalize),
-            ),
+            (renormalize_rotations
+                .run_if(any_with_component::<Inertia>)
+                .in_set(StepSystems::Renormalize),),
         );
     }
 }
@@ -152,15 +144,6 @@ fn apply_forces_at_points(mut bodies: Query<PointForce, Live>) {
     }
 }
 
-type AngularState<'a> = (
-    &'a mut Rotation,
-    &'a mut AngularMomentum,
-    &'a AngularVelocity,
-    &'a Torque,
-    &'a Inertia,
-    Option<&'a IntegratorOverride>,
-);
-
 /// One orientation step with L held: splitting for bodies with finite inertia, otherwise
 /// the chosen ω-held update (kinematic bodies turn at their set ω).
 #[inline]
@@ -177,80 +160,6 @@ pub(crate) fn turn(
         free_rotation_split(q, inertia, l, h, strang)
     } else {
         integrate_rotation(q, omega_of(inertia, q, l, stored), h, update)
-    }
-}
-
-/// The angular half of the velocity phase: L advances from τ (explicit Euler also turns q
-/// with the start-of-step ω here).
-fn integrate_angular_momenta(
-    global: Res<Integrator>,
-    update: Res<OrientationUpdate>,
-    time: Res<SubstepTime>,
-    mut bodies: Query<AngularState, Live>,
-) {
-    let h = time.h;
-    for (mut q, mut l, w, t, inertia, o) in &mut bodies {
-        let method = o.map_or(*global, |o| o.0);
-        let kick = |l: Vec3A, scale: f32| {
-            if inertia.is_infinite() {
-                l
-            } else {
-                l + (scale * h) * t.0
-            }
-        };
-        match method {
-            Integrator::ExplicitEuler => {
-                q.0 = turn(q.0, l.0, w.0, inertia, h, *update, false);
-                l.bypass_change_detection().0 = kick(l.0, 1.0);
-            }
-            Integrator::SymplecticEuler | Integrator::ImplicitEuler => {
-                l.bypass_change_detection().0 = kick(l.0, 1.0);
-            }
-            Integrator::VelocityVerlet => l.bypass_change_detection().0 = kick(l.0, 0.5),
-            Integrator::Rk4 => {}
-        }
-    }
-}
-
-type OrientationState<'a> = (
-    Entity,
-    &'a mut Rotation,
-    &'a AngularMomentum,
-    &'a AngularVelocity,
-    &'a Inertia,
-    Option<&'a IntegratorOverride>,
-);
-
-/// The angular half of the position phase: q advances with ω = I(q)⁻¹ L of the new L.
-fn integrate_orientations(
-    mut commands: Commands,
-    global: Res<Integrator>,
-    update: Res<OrientationUpdate>,
-    time: Res<SubstepTime>,
-    guard: Res<crate::core::quarantine::DivergenceGuard>,
-    mut bodies: Query<OrientationState, Live>,
-) {
-    let h = time.h;
-    let spin_limit = guard.max_angular_speed * guard.max_angular_speed;
-    for (e, mut q, l, w, inertia, o) in &mut bodies {
-        let method = o.map_or(*global, |o| o.0);
-        if matches!(
-            method,
-            Integrator::SymplecticEuler | Integrator::VelocityVerlet | Integrator::ImplicitEuler
-        ) {
-            let strang = method == Integrator::VelocityVerlet;
-            q.0 = turn(q.0, l.0, w.0, inertia, h, *update, strang);
-        }
-
-        if !(q.0.is_finite() && l.0.is_finite()) {
-            quarantine_non_finite(&mut commands, e);
-        } else if w.0.length_squared() > spin_limit {
-            commands.entity(e).insert(Quarantined {
-                reason: crate::core::quarantine::QuarantineReason::SpunOut {
-                    angular_speed: w.0.length(),
-                },
-            });
-        }
     }
 }
 

@@ -7,12 +7,13 @@ use glam::{DVec3, Vec3};
 use super::Expectation;
 use super::format::{Check, Quantity};
 use super::report::Outcome;
-use super::run::{Names, group, momentum};
+use super::select::{Names, group};
 use crate::collision::Contacts;
 use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::quarantine::Quarantined;
 use crate::core::rest::Sleeping;
 use crate::particles::LinearVelocity;
+use crate::particles::Mass;
 use crate::particles::Nodes;
 use crate::particles::Position;
 use crate::rigid::AngularVelocity;
@@ -590,4 +591,24 @@ pub(super) fn finish(x: &Expectation, track: Track, dt: f64) -> Outcome {
         time,
         measured,
     }
+}
+
+/// Σ m v over a group's movable bodies and nodes (kg·m/s).
+fn momentum(world: &World, group: &[Entity]) -> DVec3 {
+    let mut p = DVec3::ZERO;
+    for &e in group {
+        if let Some(nodes) = world.get::<Nodes>(e) {
+            for i in 0..nodes.len() {
+                if let Some(m) = nodes.mass(i).filter(|m| m.is_finite()) {
+                    p += f64::from(m) * Vec3::from(nodes.velocities()[i]).as_dvec3();
+                }
+            }
+        } else if let (Some(m), Some(v)) = (world.get::<Mass>(e), world.get::<LinearVelocity>(e))
+            && !m.is_pinned()
+            && m.value().is_finite()
+        {
+            p += f64::from(m.value()) * v.get().as_dvec3();
+        }
+    }
+    p
 }

@@ -47,6 +47,7 @@ pub mod format;
 mod load;
 mod report;
 mod run;
+mod select;
 mod spawn;
 
 use std::path::Path;
@@ -176,7 +177,7 @@ pub enum ScenarioErrorKind {
     BadValue(String),
     /// A constructor refused a value while the scene was built or an action ran.
     #[error("{0}")]
-    Build(crate::Error),
+    Build(crate::core::error::Error),
     /// The final state could not be captured for its hash.
     #[error("{0}")]
     Snapshot(crate::snapshot::SnapshotError),

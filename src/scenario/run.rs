@@ -6,14 +6,13 @@ use std::time::Instant;
 
 use bevy_ecs::message::{MessageCursor, Messages};
 use bevy_ecs::prelude::*;
-use glam::{DVec3, Vec3};
+use glam::Vec3;
 
 use super::check::{Kin, Moment, Probe, Track, evaluate, finish};
 use super::format::{Action, PluginName};
 use super::report::{Outcome, Report, Trace};
+use super::select::{Names, group, members};
 use super::{Scenario, ScenarioError, ScenarioErrorKind, Selector, spawn};
-use crate::PhysicsPlugins;
-use crate::PhysicsWorldExt;
 use crate::collision::Friction;
 use crate::collision::Restitution;
 use crate::core::error::{Error, finite_vec};
@@ -26,6 +25,8 @@ use crate::particles::LinearVelocity;
 use crate::particles::Mass;
 use crate::particles::Nodes;
 use crate::particles::Position;
+use crate::plugins::PhysicsPlugins;
+use crate::plugins::PhysicsWorldExt;
 use crate::rigid::AngularVelocity;
 use crate::rigid::ExternalTorque;
 use crate::rigid::RigidBody;
@@ -38,38 +39,6 @@ pub struct RunOptions<'a> {
     pub trace_all: bool,
     /// Called with (step, steps) every 16 steps and at the end.
     pub progress: Option<&'a mut dyn FnMut(u64, u64)>,
-}
-
-/// Names to entities.
-pub(super) type Names = HashMap<String, Vec<Entity>>;
-
-/// The entities a selector names now.
-pub(super) fn members<'a>(names: &'a Names, sel: &Selector) -> &'a [Entity] {
-    match (names.get(&sel.name), sel.index) {
-        (Some(v), Some(i)) if i < v.len() => std::slice::from_ref(&v[i]),
-        (Some(v), None) => v,
-        _ => &[],
-    }
-}
-
-/// The entities `name` or `name[i]` (negative from the end) names now, without allocating:
-/// the checks call this for every expectation at every step.
-pub(super) fn group<'a>(names: &'a Names, text: &str) -> &'a [Entity] {
-    let (name, index) = super::split_selector(text);
-    let index = index.ok().flatten();
-    let Some(all) = names.get(name) else {
-        return &[];
-    };
-    match index {
-        None => all,
-        Some(i) => {
-            let k = if i < 0 { all.len() as i64 + i } else { i };
-            usize::try_from(k)
-                .ok()
-                .and_then(|k| all.get(k))
-                .map_or(&[], std::slice::from_ref)
-        }
-    }
 }
 
 fn add_plugin(world: &mut World, p: PluginName) {
@@ -461,24 +430,4 @@ fn act(
     }
     world.flush();
     Ok(())
-}
-
-/// Σ m v over a group's movable bodies and nodes (kg·m/s).
-pub(super) fn momentum(world: &World, group: &[Entity]) -> DVec3 {
-    let mut p = DVec3::ZERO;
-    for &e in group {
-        if let Some(nodes) = world.get::<Nodes>(e) {
-            for i in 0..nodes.len() {
-                if let Some(m) = nodes.mass(i).filter(|m| m.is_finite()) {
-                    p += f64::from(m) * Vec3::from(nodes.velocities()[i]).as_dvec3();
-                }
-            }
-        } else if let (Some(m), Some(v)) = (world.get::<Mass>(e), world.get::<LinearVelocity>(e))
-            && !m.is_pinned()
-            && m.value().is_finite()
-        {
-            p += f64::from(m.value()) * v.get().as_dvec3();
-        }
-    }
-    p
 }

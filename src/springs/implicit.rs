@@ -191,11 +191,13 @@ pub(crate) fn solve_implicit_springs(
         let n = nodes.bypass_change_detection();
         if !network.fits(n) {
             commands.entity(e).insert(Quarantined {
-                reason: QuarantineReason::InvalidInput(crate::Error::IndexOutOfRange {
-                    what: "spring network endpoint",
-                    index: network.max_index as usize,
-                    len: n.len(),
-                }),
+                reason: QuarantineReason::InvalidInput(
+                    crate::core::error::Error::IndexOutOfRange {
+                        what: "spring network endpoint",
+                        index: network.max_index as usize,
+                        len: n.len(),
+                    },
+                ),
             });
             continue;
         }

@@ -40,7 +40,7 @@ pub(crate) use builders::MAX_BUILDER_NODES;
 pub use builders::{Chain, ChainBuilder};
 pub(crate) use entity_implicit::EntitySpringFactor;
 pub use plugin::SpringPlugin;
-pub(crate) use plugin::{Endpoint, Spinning, anchor_state};
+pub(crate) use plugin::{Spinning, anchor_state};
 pub use stability::{EntitySpringStability, SpringStability, StabilityPolicy, StabilityWarning};
 
 use bevy_ecs::lifecycle::HookContext;

@@ -2,18 +2,18 @@
 
 use bevy_ecs::prelude::*;
 
-use super::{Spring, SpringNetwork, spring_force};
-use glam::Vec3A;
+use glam::{Vec3, Vec3A};
 
-use crate::core::quarantine::{QuarantineReason, Quarantined};
-use crate::particles::{Force, LinearVelocity, Nodes, Position};
-use glam::Vec3;
-
-use crate::Error;
+use super::{Spring, SpringNetwork, spring_energy, spring_force};
+use crate::core::diagnostics::{PhysicsDiagnostics, energy_on};
+use crate::core::error::Error;
 use crate::core::plugin::WorldPlugin;
+use crate::core::quarantine::{QuarantineReason, Quarantined};
 use crate::core::schedule::{
-    ForceSystems, PhysicsSchedule, PrepareSystems, add_own_force_systems, add_own_systems,
+    ForceSystems, MeasureSystems, PhysicsSchedule, PrepareSystems, add_own_force_systems,
+    add_own_systems,
 };
+use crate::particles::{Force, LinearVelocity, Nodes, Position};
 use crate::rigid::{AngularVelocity, Rotation, Torque};
 
 type Live = Without<Quarantined>;
@@ -56,6 +56,11 @@ impl WorldPlugin for SpringPlugin {
         crate::core::restore::init::<super::entity_implicit::EntitySpringFactor>(world);
         crate::core::restore::init::<super::StabilityPolicy>(world);
         crate::core::plugin::add_message::<super::StabilityWarning>(world);
+        add_own_systems(
+            world,
+            PhysicsSchedule,
+            MeasureSystems::configure(measure_spring_energy.run_if(energy_on)),
+        );
         add_own_systems(
             world,
             PhysicsSchedule,
@@ -279,4 +284,31 @@ fn remove_broken_springs(
             commands.entity(e).despawn();
         }
     }
+}
+
+/// U_s = Σ ½ k (l − r)² over spring networks, then entity springs (f64), and their counts.
+fn measure_spring_energy(
+    mut diag: ResMut<PhysicsDiagnostics>,
+    meshes: Query<(&Nodes, &SpringNetwork), Without<Quarantined>>,
+    springs: Query<&Spring, Without<Quarantined>>,
+    states: Query<Endpoint, Without<Quarantined>>,
+    spinning: Query<Spinning, Without<Quarantined>>,
+) {
+    let mut us = 0.0f64;
+    diag.counts.mesh_springs = 0;
+    diag.counts.springs = 0;
+    for (nodes, net) in &meshes {
+        diag.counts.mesh_springs += net.len();
+        us += net.energy(nodes);
+    }
+    for s in &springs {
+        diag.counts.springs += 1;
+        if let (Ok(a), Ok(b)) = (states.get(s.a()), states.get(s.b())) {
+            let (anchor_a, anchor_b) = s.anchors();
+            let (pa, _, _) = anchor_state(a, spinning.get(s.a()).ok(), anchor_a);
+            let (pb, _, _) = anchor_state(b, spinning.get(s.b()).ok(), anchor_b);
+            us += spring_energy(pa, pb, s.rest_length(), s.stiffness());
+        }
+    }
+    diag.spring_energy = us;
 }
