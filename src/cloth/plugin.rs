@@ -7,6 +7,7 @@ use super::Cloth;
 use crate::core::error::Error;
 use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::{QuarantineReason, Quarantined};
+use crate::core::rest::Simulated;
 use crate::core::schedule::{
     FinishSystems, ForceSystems, PhysicsSchedule, RelaxSystems, SubstepSchedule,
     add_own_force_systems, add_own_systems,
@@ -14,8 +15,6 @@ use crate::core::schedule::{
 use crate::core::time::PhysicsTime;
 use crate::particles::{Nodes, VelocityField};
 use crate::springs::SpringNetwork;
-
-type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 /// Gauss–Seidel passes of strain limiting per substep at most; they stop once no spring is
 /// more than 0.1 % past its limit. A long chain of over-stretched springs needs about as
@@ -64,7 +63,7 @@ fn apply_wind(
     mut commands: Commands,
     time: Res<PhysicsTime>,
     fields: Query<&VelocityField>,
-    mut cloths: Query<(Entity, &mut Nodes, &Cloth), Live>,
+    mut cloths: Query<(Entity, &mut Nodes, &Cloth), Simulated>,
 ) {
     let t = time.elapsed() as f32;
     for (e, mut nodes, cloth) in &mut cloths {
@@ -112,7 +111,7 @@ fn quarantine_misfit(commands: &mut Commands, e: Entity, len: usize) {
 
 /// Shortens structural springs stretched past (1 + s_max) r, removing their ends' relative
 /// velocity along them (see the module docs).
-fn limit_strain(mut cloths: Query<(&mut Nodes, &SpringNetwork, &Cloth), Live>) {
+fn limit_strain(mut cloths: Query<(&mut Nodes, &SpringNetwork, &Cloth), Simulated>) {
     for (mut nodes, net, cloth) in &mut cloths {
         let Some(limit) = cloth.strain_limit else {
             continue;

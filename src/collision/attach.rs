@@ -148,7 +148,7 @@ impl ColliderOf {
 }
 
 fn attachment_changed(mut world: DeferredWorld, ctx: HookContext) {
-    super::broad::mark_dirty(&mut world, ctx.entity);
+    crate::collision::broad_phase::mark_dirty(&mut world, ctx.entity);
 }
 
 /// The body's own collider while its [`Collider`] holds the compound of all its parts.

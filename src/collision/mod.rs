@@ -58,36 +58,55 @@
 //! Units: m, s, kg; impulses in N·s.
 
 mod attach;
-mod broad;
-mod ccd;
-pub(crate) mod coupling;
-mod exchange;
-mod fetch;
-pub(crate) mod fused;
-mod lanes;
-mod narrow;
+pub(crate) mod broad_phase;
+pub(crate) mod lanes;
+pub(crate) mod narrow_phase;
 pub(crate) mod nodes;
 mod plugin;
-mod points;
-mod prepare;
 mod query;
-mod solver;
+pub(crate) mod slots;
+pub(crate) mod solver;
 
 pub(crate) use attach::OwnShape;
 pub use attach::{ColliderDensity, ColliderOf, ColliderOffset};
-pub(crate) use coupling::NodeImpulse;
-pub(crate) use narrow::ContactsRecord;
-pub use narrow::{ContactPair, Contacts};
+pub(crate) use narrow_phase::ContactsRecord;
+pub use narrow_phase::{ContactPair, Contacts};
+pub(crate) use nodes::coupling::NodeImpulse;
 pub use plugin::CollisionPlugin;
-pub(crate) use plugin::shape_pose;
 
-pub(crate) use broad::BroadPhaseRecord;
+pub(crate) use broad_phase::BroadPhaseRecord;
+
+/// The world pose of a manifold's part: the shape's pose, then the part's pose in it.
+#[inline]
+pub(crate) fn part_pose(shape: &Pose, part: Option<&Pose>) -> Pose {
+    part.map_or(*shape, |p| *shape * *p)
+}
+
+/// The pose of a collider's shape frame: origin x − R c.
+pub(crate) fn shape_pose(x: Vec3A, q: Quat, com: Option<&CenterOfMass>) -> Pose {
+    let c = com.map_or(Vec3::ZERO, |c| c.0);
+    Pose::from_parts(Vec3::from(x) - q * c, q)
+}
+
+/// Bounding radius of a shape about the centre of mass (m).
+pub(crate) fn radius(collider: &Collider, com: Option<&CenterOfMass>) -> f32 {
+    let [min, max] = collider.local_bounds();
+    let c = com.map_or(Vec3::ZERO, |c| c.0);
+    (min - c).length().max((max - c).length())
+}
+
+/// The bodies the contact systems see: not quarantined, and not a part of another body (its
+/// body carries it in a compound).
+pub(crate) type ContactFilter = (
+    Without<crate::core::quarantine::Quarantined>,
+    Without<ColliderOf>,
+);
 
 /// The broad phase's kept state, for a snapshot.
 pub(crate) fn broad_phase_record(world: &World) -> Option<BroadPhaseRecord> {
     world
-        .get_resource::<broad::BroadPhase>()
-        .map(broad::BroadPhase::to_record)
+        .get_resource::<broad_phase::BroadPhase>()
+        .map(broad_phase::BroadPhase::to_record)
 }
 
 /// Restores the broad phase from a snapshot's record (or, with none, has it rebuild).
@@ -96,7 +115,7 @@ pub(crate) fn restore_broad_phase(
     record: Option<&BroadPhaseRecord>,
     map: impl Fn(Entity) -> Option<Entity>,
 ) -> Result<(), Entity> {
-    let Some(mut bp) = world.get_resource_mut::<broad::BroadPhase>() else {
+    let Some(mut bp) = world.get_resource_mut::<broad_phase::BroadPhase>() else {
         return Ok(());
     };
     match record {
@@ -111,7 +130,7 @@ pub(crate) fn restore_broad_phase(
 pub use query::{Hit, Projection, QueryFilter, SpatialQuery};
 
 use bevy_ecs::prelude::*;
-use glam::{Quat, Vec3};
+use glam::{Quat, Vec3, Vec3A};
 use parry3d::math::Pose;
 use parry3d::shape::SharedShape;
 
@@ -119,7 +138,7 @@ use crate::core::error::{Error, Result, finite, finite_vec, non_negative};
 
 use crate::core::quarantine::{Validate, validate_on_insert};
 use crate::particles::Position;
-use crate::rigid::Rotation;
+use crate::rigid::{CenterOfMass, Rotation};
 
 /// A collision shape (a parry shape) attached to a body, placed at the body's shape frame:
 /// origin x − R c, where c is the [`crate::rigid::CenterOfMass`].
@@ -188,7 +207,7 @@ fn collider_changed(
     mut world: bevy_ecs::world::DeferredWorld,
     ctx: bevy_ecs::lifecycle::HookContext,
 ) {
-    broad::mark_dirty(&mut world, ctx.entity);
+    broad_phase::mark_dirty(&mut world, ctx.entity);
     if let Some(mut changes) = world.get_resource_mut::<ColliderChanges>() {
         changes.0.push(ctx.entity);
     }

@@ -24,3 +24,10 @@ pub struct SleepingDisabled;
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
 pub struct SleepTimer(pub f32);
+
+/// The bodies a substep moves: neither quarantined nor asleep. The query filter of every
+/// integrating and force system.
+pub type Simulated = (
+    Without<crate::core::quarantine::Quarantined>,
+    Without<Sleeping>,
+);

@@ -9,17 +9,15 @@ use crate::core::quarantine::Quarantined;
 use crate::particles::{Gravity, LinearVelocity, Mass, Nodes, Position, Tracer};
 use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, rotational_energy};
 
-type Live = Without<Quarantined>;
-
 /// T = Σ ½ m |v|² + Σ ½ ω·L, U_g = −Σ m g·x, P = Σ m v, L = Σ x × m v + Σ L, in f64, and the
 /// counts of particles, meshes, rigid bodies and tracers.
 pub(super) fn measure_motion(
     mut diag: ResMut<PhysicsDiagnostics>,
     gravity: Option<Res<Gravity>>,
-    bodies: Query<(&Position, &LinearVelocity, &Mass), Live>,
-    meshes: Query<&Nodes, Live>,
-    rotating: Query<(&AngularVelocity, &AngularMomentum, &Inertia), Live>,
-    tracers: Query<(), (With<Tracer>, Live)>,
+    bodies: Query<(&Position, &LinearVelocity, &Mass), Without<Quarantined>>,
+    meshes: Query<&Nodes, Without<Quarantined>>,
+    rotating: Query<(&AngularVelocity, &AngularMomentum, &Inertia), Without<Quarantined>>,
+    tracers: Query<(), (With<Tracer>, Without<Quarantined>)>,
 ) {
     let g = gravity.map_or(DVec3::ZERO, |g| g.get().as_dvec3());
     let (mut t, mut u, mut p) = (0.0f64, 0.0f64, DVec3::ZERO);

@@ -7,6 +7,7 @@ use super::{Integrator, IntegratorOverride, drift, explicit_euler, kick, mesh_di
 use crate::core::diagnostics::energy_on;
 use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::{DivergenceGuard, Quarantined, quarantine_non_finite};
+use crate::core::rest::Simulated;
 use crate::core::schedule::{
     IntegrationSystems, MeasureSystems, PhysicsSchedule, PrepareSystems, StepSystems,
     SubstepSchedule, add_own_force_systems, add_own_systems,
@@ -90,9 +91,6 @@ impl WorldPlugin for IntegratorPlugin {
     }
 }
 
-/// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
-
 /// Initialises every accumulator with the body's constant forces, f ← f_ext + m g s, and
 /// every torque accumulator with its constant torque, τ ← τ_ext.
 ///
@@ -103,12 +101,15 @@ type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 #[allow(clippy::type_complexity)] // four disjoint archetype filters; naming them adds nothing
 pub(crate) fn clear_forces(
     gravity: Option<Res<Gravity>>,
-    mut plain: Query<(&mut Force, &Mass), (Without<ExternalForce>, Without<GravityScale>, Live)>,
-    mut scaled: Query<(&mut Force, &Mass, &GravityScale), (Without<ExternalForce>, Live)>,
-    mut external: Query<(&mut Force, &Mass, &ExternalForce, Option<&GravityScale>), Live>,
-    mut meshes: Query<&mut Nodes, Live>,
-    mut plain_torques: Query<&mut Torque, (Without<ExternalTorque>, Live)>,
-    mut external_torques: Query<(&mut Torque, &ExternalTorque), Live>,
+    mut plain: Query<
+        (&mut Force, &Mass),
+        (Without<ExternalForce>, Without<GravityScale>, Simulated),
+    >,
+    mut scaled: Query<(&mut Force, &Mass, &GravityScale), (Without<ExternalForce>, Simulated)>,
+    mut external: Query<(&mut Force, &Mass, &ExternalForce, Option<&GravityScale>), Simulated>,
+    mut meshes: Query<&mut Nodes, Simulated>,
+    mut plain_torques: Query<&mut Torque, (Without<ExternalTorque>, Simulated)>,
+    mut external_torques: Query<(&mut Torque, &ExternalTorque), Simulated>,
 ) {
     let g = gravity.map_or(Vec3A::ZERO, |g| g.get().into());
     // Force is an accumulator nobody watches for changes; skipping the tick write keeps
@@ -159,7 +160,7 @@ pub(crate) fn constant_force(
 pub(crate) fn apply_impulses(
     mut bodies: Query<
         (&mut LinearVelocity, &mut ExternalImpulse, &Mass),
-        (Changed<ExternalImpulse>, Live),
+        (Changed<ExternalImpulse>, Simulated),
     >,
     mut at_points: Query<
         (
@@ -175,7 +176,7 @@ pub(crate) fn apply_impulses(
         (
             Changed<ExternalImpulseAtPoint>,
             Without<ExternalImpulse>,
-            Live,
+            Simulated,
         ),
     >,
 ) {
@@ -240,8 +241,8 @@ fn integrate_velocities(
     constraints: Res<ConstraintsActive>,
     time: Res<SubstepTime>,
     mut set: ParamSet<(
-        Query<BodyState, (Without<IntegratorOverride>, Live)>,
-        Query<(BodyState, &IntegratorOverride), Live>,
+        Query<BodyState, (Without<IntegratorOverride>, Simulated)>,
+        Query<(BodyState, &IntegratorOverride), Simulated>,
         Suspects,
     )>,
     mut meshes: Query<(&mut Nodes, Option<&IntegratorOverride>), super::ExplicitMesh>,
@@ -317,7 +318,7 @@ type Drift<'a> = (&'a mut Position, &'a LinearVelocity);
 
 /// Finds the bodies whose state is non-finite; runs only after the fast pass saw one.
 type Suspects<'w, 's> =
-    Query<'w, 's, (Entity, &'static Position, &'static LinearVelocity), (With<Mass>, Live)>;
+    Query<'w, 's, (Entity, &'static Position, &'static LinearVelocity), (With<Mass>, Simulated)>;
 
 fn quarantine_suspects(commands: &mut Commands, suspects: &Suspects, guard: &DivergenceGuard) {
     for (e, x, v) in suspects {
@@ -347,8 +348,8 @@ fn integrate_positions(
     constraints: Res<ConstraintsActive>,
     time: Res<SubstepTime>,
     mut bodies: ParamSet<(
-        Query<Drift, (With<Mass>, Without<IntegratorOverride>, Live)>,
-        Query<(Drift, &IntegratorOverride), (With<Mass>, Live)>,
+        Query<Drift, (With<Mass>, Without<IntegratorOverride>, Simulated)>,
+        Query<(Drift, &IntegratorOverride), (With<Mass>, Simulated)>,
         Suspects,
     )>,
     mut meshes: Query<(Entity, &mut Nodes, Option<&IntegratorOverride>), super::ExplicitMesh>,

@@ -7,14 +7,12 @@ use super::{Integrator, IntegratorOverride};
 use crate::core::quarantine::{
     DivergenceGuard, QuarantineReason, Quarantined, quarantine_non_finite,
 };
+use crate::core::rest::Simulated;
 use crate::core::time::SubstepTime;
 use crate::rigid::turn;
 use crate::rigid::{
     AngularMomentum, AngularVelocity, Inertia, OrientationUpdate, Rotation, Torque,
 };
-
-/// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 type AngularState<'a> = (
     &'a mut Rotation,
@@ -31,7 +29,7 @@ pub(super) fn integrate_angular_momenta(
     global: Res<Integrator>,
     update: Res<OrientationUpdate>,
     time: Res<SubstepTime>,
-    mut bodies: Query<AngularState, Live>,
+    mut bodies: Query<AngularState, Simulated>,
 ) {
     let h = time.h;
     for (mut q, mut l, w, t, inertia, o) in &mut bodies {
@@ -73,7 +71,7 @@ pub(super) fn integrate_orientations(
     update: Res<OrientationUpdate>,
     time: Res<SubstepTime>,
     guard: Res<DivergenceGuard>,
-    mut bodies: Query<OrientationState, Live>,
+    mut bodies: Query<OrientationState, Simulated>,
 ) {
     let h = time.h;
     let spin_limit = guard.max_angular_speed * guard.max_angular_speed;

@@ -15,13 +15,11 @@ use glam::{Quat, Vec3A};
 
 use super::{Integrator, IntegratorOverride, kick};
 use crate::core::quarantine::{QuarantineReason, Quarantined};
+use crate::core::rest::Simulated;
 use crate::core::schedule::ForceSchedule;
 use crate::core::time::SubstepTime;
 use crate::particles::{Force, LinearVelocity, Mass, Nodes, Position};
 use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, Rotation, Torque, quat_derivative};
-
-/// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 const WEIGHT: [f32; 4] = [1.0, 2.0, 2.0, 1.0];
 const OFFSET: [f32; 3] = [0.5, 0.5, 1.0];
@@ -143,9 +141,9 @@ type StageRotation<'a> = (
 /// Verlet's second kick and RK4's stages 2–4.
 pub(crate) fn complete_stages(
     world: &mut World,
-    bodies: &mut QueryState<StageBody, Live>,
+    bodies: &mut QueryState<StageBody, Simulated>,
     meshes: &mut QueryState<(Entity, &mut Nodes, Option<&IntegratorOverride>), super::ExplicitMesh>,
-    rotations: &mut QueryState<StageRotation, Live>,
+    rotations: &mut QueryState<StageRotation, Simulated>,
     mut scratch: Local<StageScratch>,
 ) {
     let global = *world.resource::<Integrator>();

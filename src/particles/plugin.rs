@@ -7,14 +7,12 @@ use super::fields::{Advection, Gravity, VelocityField};
 use super::fields::{advect_euler, advect_midpoint, advect_rk4};
 use super::{Force, LinearDamping, LinearVelocity, Mass, Position, Tracer};
 use crate::core::plugin::WorldPlugin;
-use crate::core::quarantine::{Quarantined, quarantine_non_finite};
+use crate::core::quarantine::quarantine_non_finite;
+use crate::core::rest::Simulated;
 use crate::core::schedule::{
     ForceSystems, StepSystems, SubstepSchedule, add_own_force_systems, add_own_systems,
 };
 use crate::core::time::SubstepTime;
-
-/// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 /// Uniform gravity, f = m g s: installs the [`Gravity`] resource. Gravity is a constant
 /// force, so the core's force-clearing pass writes it into each accumulator (see
@@ -45,7 +43,9 @@ impl WorldPlugin for DampingPlugin {
     }
 }
 
-fn apply_damping(mut bodies: Query<(&mut Force, &LinearVelocity, &Mass, &LinearDamping), Live>) {
+fn apply_damping(
+    mut bodies: Query<(&mut Force, &LinearVelocity, &Mass, &LinearDamping), Simulated>,
+) {
     for (mut f, v, m, c) in &mut bodies {
         f.bypass_change_detection().0 -= (c.0 * m.force_scale()) * v.0;
     }
@@ -71,7 +71,7 @@ impl WorldPlugin for VelocityFieldPlugin {
 
 /// Tracers are massless; `Without<Mass>` also proves to the scheduler that this query never
 /// aliases the particle integrator's positions.
-type TracerFilter = (With<Tracer>, Without<Mass>, Live);
+type TracerFilter = (With<Tracer>, Without<Mass>, Simulated);
 
 fn advect_tracers(
     mut commands: Commands,

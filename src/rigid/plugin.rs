@@ -10,16 +10,13 @@ use super::{
     free_rotation_split, integrate_rotation, omega_of, world_point,
 };
 use crate::core::plugin::WorldPlugin;
-use crate::core::quarantine::Quarantined;
+use crate::core::rest::Simulated;
 use crate::core::schedule::{
     ForceSystems, PhysicsSchedule, PrepareSystems, StepSystems, SubstepSchedule,
     add_own_force_systems, add_own_systems,
 };
 use crate::core::time::PhysicsTime;
 use crate::particles::{Force, LinearVelocity, Position};
-
-/// Bodies the step moves: not quarantined, not asleep.
-type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
 
 /// Rotation, angular momentum, torque and renormalisation for bodies with [`Inertia`]. Every
 /// system runs only while such a body exists (or, for the optional inputs, while one has
@@ -100,7 +97,7 @@ type KinematicDrive<'a> = (
 );
 
 /// v = (target − x)/dt and ω = log(q_target q⁻¹)/dt, so the pose is reached at the step's end.
-fn drive_kinematic_targets(time: Res<PhysicsTime>, mut bodies: Query<KinematicDrive, Live>) {
+fn drive_kinematic_targets(time: Res<PhysicsTime>, mut bodies: Query<KinematicDrive, Simulated>) {
     let dt = time.dt();
     for (x, q, target, mut v, mut w) in &mut bodies {
         v.0 = (Vec3A::from(target.position) - x.0) / dt;
@@ -114,7 +111,7 @@ fn drive_kinematic_targets(time: Res<PhysicsTime>, mut bodies: Query<KinematicDr
 
 /// τ −= c L.
 fn apply_angular_damping(
-    mut bodies: Query<(&mut Torque, &AngularMomentum, &AngularDamping), Live>,
+    mut bodies: Query<(&mut Torque, &AngularMomentum, &AngularDamping), Simulated>,
 ) {
     for (mut t, l, c) in &mut bodies {
         t.bypass_change_detection().0 -= c.0 * l.0;
@@ -131,7 +128,7 @@ type PointForce<'a> = (
 );
 
 /// f += F, τ += (p − x) × F.
-fn apply_forces_at_points(mut bodies: Query<PointForce, Live>) {
+fn apply_forces_at_points(mut bodies: Query<PointForce, Simulated>) {
     for (x, q, com, ext, mut f, mut t) in &mut bodies {
         let p = if ext.local {
             world_point(x.0, q.0, com.map_or(glam::Vec3::ZERO, |c| c.0), ext.point)
@@ -176,7 +173,7 @@ fn renormalize_rotations(
             &mut AngularVelocity,
             Has<SkipRenormalization>,
         ),
-        Live,
+        Simulated,
     >,
 ) {
     for (mut q, l, inertia, mut w, skip) in &mut bodies {

@@ -31,7 +31,7 @@ use bevy_ecs::prelude::*;
 use glam::{Mat3, Vec3, Vec3A};
 use nalgebra::{DMatrix, DVector};
 
-use crate::collision::coupling::{RigidSide, move_soft, soft_response};
+use crate::collision::nodes::coupling::{RigidSide, move_soft, soft_response};
 use crate::integrator::skyline::SkylineCholesky;
 
 use crate::core::error::{Error, Result};

@@ -6,6 +6,7 @@ use super::SoftBody;
 use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::{QuarantineReason, Quarantined};
+use crate::core::rest::Simulated;
 use crate::core::schedule::{
     FinishSystems, ForceSystems, PhysicsSchedule, RelaxSystems, SubstepSchedule,
     add_own_force_systems, add_own_systems,
@@ -74,12 +75,10 @@ impl WorldPlugin for SoftBodyPlugin {
     }
 }
 
-type Live = (Without<Quarantined>, Without<crate::core::rest::Sleeping>);
-
 /// f += −V P(F) Dm⁻ᵀ per tetrahedron; a body whose forces come out non-finite is quarantined.
 fn apply_elastic_forces(
     mut commands: Commands,
-    mut bodies: Query<(Entity, &mut Nodes, &mut SoftBody), (Live, Without<ImplicitEuler>)>,
+    mut bodies: Query<(Entity, &mut Nodes, &mut SoftBody), (Simulated, Without<ImplicitEuler>)>,
 ) {
     for (e, mut nodes, mut body) in &mut bodies {
         let n = nodes.bypass_change_detection();
@@ -108,7 +107,7 @@ fn solve_implicit(
             &ImplicitEuler,
             &mut ImplicitState,
         ),
-        Live,
+        Simulated,
     >,
     mut scratch: Local<crate::integrator::implicit::Scratch<SoftBody>>,
 ) {

@@ -44,8 +44,6 @@ use crate::integrator::{ImplicitEuler, ImplicitState, Integrator, IntegratorOver
 use crate::particles::{Force, LinearVelocity, Mass, Nodes, Position};
 use crate::rigid::{Inertia, Torque};
 
-type Live = Without<Quarantined>;
-
 /// What the solve needs of an end's body.
 pub(crate) type EndBody<'a> = (
     &'a Position,
@@ -158,11 +156,11 @@ pub(crate) fn solve_entity_springs(
     global: Res<Integrator>,
     guard: Res<DivergenceGuard>,
     time: Res<SubstepTime>,
-    springs: Query<(Entity, &Spring, Option<&ImplicitEuler>), Live>,
-    bodies: Query<EndBody, Live>,
-    spinning: Query<(Spinning, &Inertia), Live>,
-    mut forces: Query<&mut Force, Live>,
-    mut torques: Query<&mut Torque, Live>,
+    springs: Query<(Entity, &Spring, Option<&ImplicitEuler>), Without<Quarantined>>,
+    bodies: Query<EndBody, Without<Quarantined>>,
+    spinning: Query<(Spinning, &Inertia), Without<Quarantined>>,
+    mut forces: Query<&mut Force, Without<Quarantined>>,
+    mut torques: Query<&mut Torque, Without<Quarantined>>,
     mut solve: Local<EntitySolve>,
     mut kept: ResMut<EntitySpringFactor>,
     (archetypes, spring_id, mut order): (

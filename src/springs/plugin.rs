@@ -16,8 +16,6 @@ use crate::core::schedule::{
 use crate::particles::{Force, LinearVelocity, Nodes, Position};
 use crate::rigid::{AngularVelocity, Rotation, Torque};
 
-type Live = Without<Quarantined>;
-
 /// Spring forces for [`Spring`] entities and [`SpringNetwork`] meshes. Each system runs only
 /// while its kind of spring exists.
 #[derive(Debug, Default, Clone, Copy)]
@@ -114,12 +112,12 @@ fn apply_spring_forces(
     mut commands: Commands,
     guard: Res<crate::core::quarantine::DivergenceGuard>,
     global: Res<crate::integrator::Integrator>,
-    springs: Query<(Entity, &Spring, Has<crate::integrator::ImplicitEuler>), Live>,
-    states: Query<Endpoint, Live>,
-    ends: Query<super::entity_implicit::EndBody, Live>,
-    spinning: Query<Spinning, Live>,
-    mut forces: Query<&mut Force, Live>,
-    mut torques: Query<&mut Torque, Live>,
+    springs: Query<(Entity, &Spring, Has<crate::integrator::ImplicitEuler>), Without<Quarantined>>,
+    states: Query<Endpoint, Without<Quarantined>>,
+    ends: Query<super::entity_implicit::EndBody, Without<Quarantined>>,
+    spinning: Query<Spinning, Without<Quarantined>>,
+    mut forces: Query<&mut Force, Without<Quarantined>>,
+    mut torques: Query<&mut Torque, Without<Quarantined>>,
     masses: Query<&crate::particles::Mass>,
     positions: Query<&Position>,
     (archetypes, spring_id, mut order): (
@@ -220,7 +218,7 @@ fn orphaned(
     guard: &crate::core::quarantine::DivergenceGuard,
     spring: Entity,
     s: &Spring,
-    states: &Query<Endpoint, Live>,
+    states: &Query<Endpoint, Without<Quarantined>>,
     positions: &Query<&Position>,
     masses: &Query<&crate::particles::Mass>,
 ) {
@@ -250,7 +248,10 @@ fn apply_network_forces(
     mut commands: Commands,
     mut meshes: Query<
         (Entity, &mut Nodes, &SpringNetwork),
-        (Live, Without<crate::integrator::ImplicitEuler>),
+        (
+            Without<Quarantined>,
+            Without<crate::integrator::ImplicitEuler>,
+        ),
     >,
 ) {
     for (e, mut nodes, network) in &mut meshes {

@@ -246,8 +246,8 @@ fn every_substep_system_is_replicated_or_blocks_the_path() {
         "hooke::integrator::rotation::integrate_angular_momenta",
         "hooke::integrator::rotation::integrate_orientations",
         "hooke::rigid::plugin::renormalize_rotations",
-        "hooke::collision::plugin::solve_contacts",
-        "hooke::collision::plugin::relax_contacts",
+        "hooke::collision::solver::plugin::solve_contacts",
+        "hooke::collision::solver::plugin::relax_contacts",
         // The timing probes between the sets: nothing to replicate.
         "hooke::core::diagnostics::install::{{closure}}",
     ];
@@ -267,7 +267,7 @@ fn every_substep_system_is_replicated_or_blocks_the_path() {
         "hooke::soft::plugin::solve_implicit",       // SoftBody, ImplicitEuler
         "hooke::soft::attach::solve_attachments",    // NodeAttachments
         "hooke::collision::nodes::collide_nodes<hooke::soft::SoftBody>", // SoftBody
-        "hooke::collision::coupling::apply_node_impulses", // NodeImpulse
+        "hooke::collision::nodes::coupling::apply_node_impulses", // NodeImpulse
         "hooke::cloth::plugin::apply_wind",          // Cloth
         "hooke::cloth::plugin::limit_strain",        // Cloth
         "hooke::collision::nodes::collide_nodes<hooke::cloth::Cloth>", // Cloth

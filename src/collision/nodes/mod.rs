@@ -15,7 +15,7 @@
 //! **Two-way with dynamic bodies.** The nodes in a dynamic body's contact layer are pushed out
 //! by normal impulses λ ≥ 0 found together: the overlaps C (m, negative inside the layer)
 //! must close, G λ ≥ −C / h, with G the coupled response of both sides (see
-//! [`super::coupling`]: the soft body answers through its implicit solve's factor, so a stiff
+//! [`crate::collision::nodes::coupling`]: the soft body answers through its implicit solve's factor, so a stiff
 //! body moves as a whole; a light body is pushed back by the heavy soft one). Projected
 //! Gauss–Seidel on that small system, then Coulomb friction per node capped at μ λ; the body
 //! takes −λ at each node. No plane holds a node to a dynamic body inside the solve: such a
@@ -31,11 +31,13 @@
 //! substeps, lumped masses) peaks at 4.6 m/s at landing against the fall's 2.4 m/s.
 //! Soft–soft contact is not handled.
 
+pub(crate) mod coupling;
+
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3, Vec3A};
 use parry3d::math::Pose;
 
-use super::coupling::{NodeImpulse, RigidSide, move_soft, soft_response};
+use crate::collision::nodes::coupling::{NodeImpulse, RigidSide, move_soft, soft_response};
 use crate::collision::{Collider, ColliderAabb, ColliderOf, Friction};
 use crate::core::quarantine::Quarantined;
 use crate::core::time::SubstepTime;

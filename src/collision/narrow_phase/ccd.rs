@@ -29,8 +29,8 @@ use parry3d::math::Pose;
 use parry3d::query::{NonlinearRigidMotion, ShapeCastOptions, ShapeCastStatus, TrackedContact};
 use parry3d::shape::{PackedFeatureId, Shape};
 
-use super::narrow::{Manifold, ManifoldData};
-use super::points::choose_points;
+use crate::collision::narrow_phase::points::choose_points;
+use crate::collision::narrow_phase::{Manifold, ManifoldData};
 
 /// Cosine of the angle within which a manifold's normal counts as the impact's.
 const SAME_NORMAL: f32 = 0.99;

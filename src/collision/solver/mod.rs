@@ -23,10 +23,15 @@
 //! batch, after the colours. The order is fixed by the order of the manifolds, so results
 //! are bit-identical from run to run.
 
+pub(crate) mod exchange;
+pub(crate) mod fused;
+pub(crate) mod plugin;
+pub(crate) mod prepare;
+
 use bevy_ecs::prelude::*;
 use glam::{Mat3A, Quat, Vec3A};
 
-use super::lanes::{F4, M3, Q4, V3};
+use crate::collision::lanes::{F4, M3, Q4, V3};
 
 /// Index of the immovable "body" that stands for every static collider.
 pub(crate) const FIXED: u32 = u32::MAX;
@@ -77,7 +82,7 @@ impl SolverBody {
             x0: Vec3A::ZERO,
             q0: Quat::IDENTITY,
             q_seen: Quat::IDENTITY,
-            same_turn: super::exchange::ROUNDING_TURN,
+            same_turn: crate::collision::solver::exchange::ROUNDING_TURN,
             w_in: Vec3A::ZERO,
             dynamic: true,
             isotropic: false,
@@ -277,8 +282,8 @@ pub(crate) struct ContactSolver {
     pub manifolds: Vec<ManifoldConstraint>,
     pub inputs: Vec<PointInput>,
     pub index: BodyMap,
-    /// Where the bodies sit in the ECS storage order (see [`super::exchange`]).
-    pub order: super::exchange::StorageOrder,
+    /// Where the bodies sit in the ECS storage order (see [`crate::collision::solver::exchange`]).
+    pub order: crate::collision::solver::exchange::StorageOrder,
     batches: Vec<Batch>,
     points: Vec<Point>,
     /// Per point, its restitution record.
@@ -294,42 +299,9 @@ pub(crate) struct ContactSolver {
     used: Vec<u64>,
 }
 
-/// A per-step index of items by entity, kept in an array by the entity's index: a lookup is
-/// a load and a check against the entity the item holds, not a hash.
-#[derive(Debug, Default)]
-pub(crate) struct EntitySlots {
-    slots: Vec<u32>,
-}
-
-impl EntitySlots {
-    /// The index of `e`'s item, if it has one; `entity_of(i)` is the entity item i holds.
-    #[inline]
-    pub fn find(&self, e: Entity, entity_of: impl Fn(usize) -> Option<Entity>) -> Option<u32> {
-        let i = *self.slots.get(e.index_u32() as usize)?;
-        (entity_of(i as usize) == Some(e)).then_some(i)
-    }
-
-    pub fn insert(&mut self, e: Entity, i: u32) {
-        let k = e.index_u32() as usize;
-        if k >= self.slots.len() {
-            self.slots.resize(k + 1, u32::MAX);
-        }
-        self.slots[k] = i;
-    }
-
-    /// Forgets the given entities' items.
-    pub fn clear(&mut self, entities: impl Iterator<Item = Entity>) {
-        for e in entities {
-            if let Some(slot) = self.slots.get_mut(e.index_u32() as usize) {
-                *slot = u32::MAX;
-            }
-        }
-    }
-}
-
 /// Solver index per entity.
 #[derive(Debug, Default)]
-pub(crate) struct BodyMap(EntitySlots);
+pub(crate) struct BodyMap(crate::collision::slots::EntitySlots);
 
 impl BodyMap {
     /// The solver index of `e`, if it has one this step.
@@ -906,7 +878,8 @@ impl ContactSolver {
                 (0..4).filter_map(move |l| {
                     let m = self.manifolds.get(batch.lanes[l] as usize)?;
                     let inputs = &self.inputs[m.first as usize..(m.first + m.count) as usize];
-                    let mut normals = [(0, 0.0); super::points::MAX_POINTS];
+                    let mut normals =
+                        [(0, 0.0); crate::collision::narrow_phase::points::MAX_POINTS];
                     for ((slot, p), input) in normals.iter_mut().zip(points).zip(inputs) {
                         *slot = (input.source, p.n_imp.to_array()[l]);
                     }
@@ -927,7 +900,7 @@ impl ContactSolver {
 pub(crate) struct SolvedManifold<'a> {
     pub constraint: &'a ManifoldConstraint,
     /// (point index in the narrow phase's manifold, normal impulse); the first `count`.
-    pub normals: [(u32, f32); super::points::MAX_POINTS],
+    pub normals: [(u32, f32); crate::collision::narrow_phase::points::MAX_POINTS],
     pub count: usize,
     pub tangent: Vec3A,
     pub twist: f32,

@@ -5,14 +5,14 @@ use bevy_ecs::prelude::*;
 use glam::{Mat3A, Quat, Vec3, Vec3A};
 use parry3d::math::Pose;
 
-use super::broad::BroadPhase;
-use super::exchange::Live;
-use super::fetch::Wanted;
-use super::narrow::{Contacts, FrozenGeometry};
-use super::plugin::{part_pose, shape_pose};
-use super::points::MAX_POINTS;
-use super::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, SolverBody};
-use super::{Collider, ContactSettings, Friction, Restitution, RestitutionThreshold};
+use crate::collision::ContactFilter;
+use crate::collision::broad_phase::BroadPhase;
+use crate::collision::narrow_phase::fetch::Wanted;
+use crate::collision::narrow_phase::points::MAX_POINTS;
+use crate::collision::narrow_phase::{Contacts, FrozenGeometry};
+use crate::collision::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, SolverBody};
+use crate::collision::{Collider, ContactSettings, Friction, Restitution, RestitutionThreshold};
+use crate::collision::{part_pose, shape_pose};
 use crate::core::rest::Sleeping;
 use crate::integrator::ConstraintsActive;
 use crate::particles::{LinearVelocity, Mass, Position};
@@ -40,7 +40,7 @@ type PreparedBody<'a> = (
 
 /// One side of the step's contacts as constraint building needs it, fetched once per step
 /// however many pairs its body is in.
-pub(super) struct Side {
+pub(crate) struct Side {
     entity: Entity,
     /// Solver index, [`FIXED`], or [`Side::UNSET`] until a contact first needs it.
     index: u32,
@@ -102,8 +102,8 @@ impl Side {
             .or_else(|| com.and_then(|c| c.validate().err()));
         let (friction, restitution, threshold) = if bad_material.is_some() {
             (
-                super::Friction::default().0,
-                super::Restitution::default().0,
+                crate::collision::Friction::default().0,
+                crate::collision::Restitution::default().0,
                 None,
             )
         } else {
@@ -112,8 +112,8 @@ impl Side {
         Side {
             entity,
             round: Roundness::of(collider.shape()),
-            thin: super::ccd::thickness(collider.local_bounds()),
-            reach: super::plugin::radius(collider, com),
+            thin: crate::collision::narrow_phase::ccd::thickness(collider.local_bounds()),
+            reach: crate::collision::radius(collider, com),
             index: Side::UNSET,
             x: x.0,
             q: q.0,
@@ -220,7 +220,7 @@ fn new_body(solver: &mut ContactSolver, side: &Side) -> u32 {
         x0: x,
         q0: q,
         q_seen: q,
-        same_turn: super::exchange::same_turn(side.reach),
+        same_turn: crate::collision::solver::exchange::same_turn(side.reach),
         w_in: side.w,
         dynamic,
         isotropic: side.inertia.as_ref().is_some_and(Inertia::is_isotropic),
@@ -242,14 +242,14 @@ fn new_body(solver: &mut ContactSolver, side: &Side) -> u32 {
 /// position).
 fn tangent_basis(
     n: Vec3A,
-    m: &super::narrow::Manifold,
+    m: &crate::collision::narrow_phase::Manifold,
     centre: Vec3A,
     (xa, va, wa): (Vec3A, Vec3A, Vec3A),
     (xb, vb, wb): (Vec3A, Vec3A, Vec3A),
 ) -> [Vec3A; 2] {
     let slide = (vb + wb.cross(centre - xb)) - (va + wa.cross(centre - xa));
     let impulse = Vec3A::from(m.data.tangent);
-    let normal = super::points::kept_normal_impulse(m);
+    let normal = crate::collision::narrow_phase::points::kept_normal_impulse(m);
     let along = |v: Vec3A| (v - n * n.dot(v)).try_normalize();
     // Only a clear signal picks the direction: below it (a body at rest under a small
     // sideways load) a noisy direction would turn the basis from step to step, and a fixed
@@ -262,13 +262,13 @@ fn tangent_basis(
 }
 
 #[allow(clippy::too_many_arguments)] // the step's inputs and its reused buffers
-pub(super) fn prepare_contacts(
+pub(crate) fn prepare_contacts(
     mut solver: ResMut<ContactSolver>,
     mut active: ResMut<ConstraintsActive>,
     mut contacts: ResMut<Contacts>,
     bp: Res<BroadPhase>,
     settings: Res<ContactSettings>,
-    bodies: Query<PreparedBody, (With<Collider>, Live)>,
+    bodies: Query<PreparedBody, (With<Collider>, ContactFilter)>,
     mut buffers: Local<PrepareBuffers>,
     mut commands: Commands,
 ) {
@@ -373,7 +373,14 @@ pub(super) fn prepare_contacts(
                 .iter()
                 .map(|&k| m.points[usize::from(k)].dist)
                 .fold(f32::INFINITY, f32::min);
-            if -deepest > 0.25 * super::ccd::pair_thickness(a.thin, b.thin, settings.margin) {
+            if -deepest
+                > 0.25
+                    * crate::collision::narrow_phase::ccd::pair_thickness(
+                        a.thin,
+                        b.thin,
+                        settings.margin,
+                    )
+            {
                 for i in [ia, ib] {
                     if let Some(body) = s.bodies.get_mut(i as usize) {
                         body.deep = true;
@@ -407,7 +414,12 @@ pub(super) fn prepare_contacts(
 
 /// The normal and lever arms of `m` at the present poses of `a` and `b` (see
 /// [`FrozenGeometry`]).
-fn freeze(m: &super::narrow::Manifold, a: &Side, b: &Side, touch: f32) -> FrozenGeometry {
+fn freeze(
+    m: &crate::collision::narrow_phase::Manifold,
+    a: &Side,
+    b: &Side,
+    touch: f32,
+) -> FrozenGeometry {
     // A compound's manifold is in its part's frame; the part's pose in the compound comes
     // with the manifold.
     let (pose_a, pose_b) = (

@@ -1,5 +1,10 @@
 //! Narrow phase: persistent contact manifolds per pair, and the contact query API.
 
+pub(crate) mod ccd;
+pub(crate) mod fetch;
+pub(crate) mod plugin;
+pub(crate) mod points;
+
 use bevy_platform::collections::HashMap;
 
 use bevy_ecs::prelude::*;
@@ -7,7 +12,7 @@ use glam::Vec3;
 use parry3d::math::Pose;
 use parry3d::query::{ContactManifold, ContactManifoldsWorkspace};
 
-use super::points::{MAX_POINTS, kept_normal_impulse};
+use crate::collision::narrow_phase::points::{MAX_POINTS, kept_normal_impulse};
 
 /// What each contact point carries from step to step: its accumulated normal impulse, for
 /// warm starting. parry moves it to the matching point of the next step's manifold.
@@ -19,7 +24,7 @@ pub(crate) struct ContactImpulse {
 
 /// What a manifold carries from step to step: its friction impulses, for warm starting, and
 /// which of its points the solver takes (chosen when its points are found, see
-/// [`choose_points`](super::points::choose_points)).
+/// [`choose_points`](crate::collision::narrow_phase::points::choose_points)).
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct ManifoldData {
     /// Friction impulse at the manifold's centre (N·s, world frame).

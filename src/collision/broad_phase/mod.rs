@@ -14,6 +14,7 @@
 //!   reshaped or removed. Each awake moving box queries it: O(log n_fixed) per box. A fixed
 //!   collider costs nothing per step while nothing about it changes.
 
+pub(crate) mod plugin;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use parry3d::bounding_volume::Aabb;
@@ -24,7 +25,7 @@ use crate::particles::{LinearVelocity, Position};
 use crate::rigid::Rotation;
 
 use super::CollisionLayers;
-use super::lanes::F4;
+use crate::collision::lanes::F4;
 
 /// One collider's box as the broad phase sees it.
 #[derive(Debug, Clone, Copy, serde::Serialize, serde::Deserialize)]

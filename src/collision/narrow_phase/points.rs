@@ -2,7 +2,7 @@
 
 use glam::{Vec3, Vec3A};
 
-use super::narrow::{ContactImpulse, Manifold};
+use crate::collision::narrow_phase::{ContactImpulse, Manifold};
 
 /// Most points a manifold keeps for the solver: four span any convex contact patch, and
 /// parry's face–face clipping can give eight (a box resting squarely on another), which
@@ -94,7 +94,7 @@ pub(crate) fn choose_changed_points(
 /// face: a cube landing flat slid and tipped, and the symmetric relax sweep (see the
 /// solver) lost its point.
 ///
-/// [`FrozenGeometry`]: super::narrow::FrozenGeometry
+/// [`FrozenGeometry`]: crate::collision::narrow_phase::FrozenGeometry
 fn solve_order(keep: &mut [usize], m: &Manifold) {
     if keep.len() < 2 {
         return;

@@ -19,8 +19,8 @@
 use bevy_ecs::prelude::*;
 use glam::{Mat3A, Vec3A};
 
-use super::solver::{BodyState, ContactSolver};
-use crate::core::quarantine::Quarantined;
+use crate::collision::ContactFilter;
+use crate::collision::solver::{BodyState, ContactSolver};
 use crate::particles::{LinearVelocity, Position};
 use crate::rigid::{AngularMomentum, AngularVelocity, Rotation};
 
@@ -32,14 +32,14 @@ const NONE: u32 = u32::MAX;
 const ANCHOR_LAG: f32 = 1e-5;
 
 /// The smallest reuse limit (squared quaternion distance): a renormalisation's rounding.
-pub(super) const ROUNDING_TURN: f32 = 1e-12;
+pub(crate) const ROUNDING_TURN: f32 = 1e-12;
 
 /// The squared quaternion distance within which a body of bounding radius `reach` (m)
 /// reuses its ΔR: a turn by θ moves a point r out by θ r, and θ ≈ 2 |Δq|. At least
 /// [`ROUNDING_TURN`] (the limit before the tolerance), which sets it past a reach of
 /// 0.87 m: there the lag is up to 2e-6 rad times the reach.
 #[must_use]
-pub(super) fn same_turn(reach: f32) -> f32 {
+pub(crate) fn same_turn(reach: f32) -> f32 {
     let d = ANCHOR_LAG / (2.0 * reach);
     if d.is_finite() {
         (d * d).max(ROUNDING_TURN)
@@ -51,7 +51,7 @@ pub(super) fn same_turn(reach: f32) -> f32 {
 /// A walk pays while at least this share of the query's bodies are in the solver.
 const WALK_SHARE: usize = 4;
 
-pub(super) type SolvedBody<'a> = (
+pub(crate) type SolvedBody<'a> = (
     Entity,
     &'a Position,
     &'a Rotation,
@@ -59,10 +59,6 @@ pub(super) type SolvedBody<'a> = (
     Option<&'a mut AngularMomentum>,
     Option<&'a AngularVelocity>,
 );
-
-/// Bodies the contact systems see: not quarantined, and not a part of another body (its
-/// body carries it in a compound).
-pub(super) type Live = (Without<Quarantined>, Without<super::ColliderOf>);
 
 /// Where each solver body sits in the query's storage order, for one step.
 #[derive(Debug, Default)]
@@ -97,7 +93,7 @@ impl StorageOrder {
     }
 }
 
-fn record(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
+fn record(solver: &mut ContactSolver, bodies: &Query<SolvedBody, ContactFilter>) {
     let order = &mut solver.order;
     order.ready = true;
     order.slots.clear();
@@ -142,7 +138,7 @@ fn walk<Q>(
 }
 
 /// Reads the current state of every body in contact into the solver.
-pub(super) fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, Live>) {
+pub(crate) fn gather(solver: &mut ContactSolver, bodies: &Query<SolvedBody, ContactFilter>) {
     if !solver.order.ready {
         record(solver, bodies);
     }
@@ -199,7 +195,7 @@ fn read(
 /// angular momentum `l` (none for a body without inertia) and stored ω `w`.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)] // one body's state, field by field
-pub(super) fn read_values(
+pub(crate) fn read_values(
     solver: &mut ContactSolver,
     i: usize,
     x: Vec3A,
@@ -251,7 +247,7 @@ pub(super) fn read_values(
 }
 
 /// Writes the solved velocities back.
-pub(super) fn scatter(solver: &mut ContactSolver, bodies: &mut Query<SolvedBody, Live>) {
+pub(crate) fn scatter(solver: &mut ContactSolver, bodies: &mut Query<SolvedBody, ContactFilter>) {
     let pass = solver.order.begin(solver.bodies.len());
     let mut hits = 0;
     if solver.order.walk && solver.order.ready {
@@ -295,7 +291,7 @@ fn write(
 
 /// I₀ Δω, the angular impulse of a pass.
 #[inline(always)]
-fn angular_impulse(b: &super::solver::SolverBody, state: &BodyState) -> Vec3A {
+fn angular_impulse(b: &crate::collision::solver::SolverBody, state: &BodyState) -> Vec3A {
     let dw = state.w - b.w_in;
     // An isotropic body's tensor is an exact diagonal (see `Inertia::world_tensors`): the
     // scalar product is the matrix product without its added zeros.
@@ -309,7 +305,7 @@ fn angular_impulse(b: &super::solver::SolverBody, state: &BodyState) -> Vec3A {
 /// [`write()`] to plain values: v ← the solved v, L += I₀ Δω. Nothing for a body that is not
 /// dynamic.
 #[inline(always)]
-pub(super) fn write_values(solver: &ContactSolver, i: usize, v: &mut Vec3A, l: Option<&mut Vec3A>) {
+pub(crate) fn write_values(solver: &ContactSolver, i: usize, v: &mut Vec3A, l: Option<&mut Vec3A>) {
     let (b, state) = (&solver.bodies[i], &solver.states[i]);
     if !b.dynamic {
         return;
@@ -329,7 +325,7 @@ mod tests {
 
     type Params = (
         ResMut<'static, ContactSolver>,
-        Query<'static, 'static, SolvedBody<'static>, Live>,
+        Query<'static, 'static, SolvedBody<'static>, ContactFilter>,
     );
 
     fn body(world: &mut World, i: usize) -> Entity {

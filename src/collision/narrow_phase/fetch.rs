@@ -10,7 +10,7 @@
 use bevy_ecs::prelude::*;
 use bevy_ecs::query::{QueryData, QueryFilter, ROQueryItem};
 
-use super::solver::EntitySlots;
+use crate::collision::slots::EntitySlots;
 
 /// A walk pays while at least this share of the query's entities are wanted.
 const WALK_SHARE: usize = 4;

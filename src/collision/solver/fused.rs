@@ -19,11 +19,11 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemState;
 use glam::{Quat, Vec3A};
 
-use super::ContactSettings;
-use super::exchange::{read_values, write_values};
-use super::narrow::Contacts;
-use super::plugin::{biased_pass, relax_pass};
-use super::solver::ContactSolver;
+use crate::collision::ContactSettings;
+use crate::collision::narrow_phase::Contacts;
+use crate::collision::solver::ContactSolver;
+use crate::collision::solver::exchange::{read_values, write_values};
+use crate::collision::solver::plugin::{biased_pass, relax_pass};
 use crate::core::quarantine::{DivergenceGuard, QuarantineReason, Quarantined};
 use crate::core::time::{PhysicsTime, SubstepTime};
 use crate::integrator::{Integrator, constant_force, drift, kick};
@@ -36,11 +36,11 @@ use crate::rigid::{
 };
 
 /// Registers the path; called by the collision plugin.
-pub(super) fn install(world: &mut World) {
+pub(crate) fn install(world: &mut World) {
     let state = SystemState::<Params>::new(world);
     world.insert_resource(Cache(Some(state)));
     world.insert_resource(crate::core::whole_step::WholeStepRunner(run));
-    crate::core::whole_step::block_on::<super::coupling::NodeImpulse>(world);
+    crate::core::whole_step::block_on::<crate::collision::nodes::coupling::NodeImpulse>(world);
 }
 
 type Body<'a> = (

@@ -1,0 +1,312 @@
+//! The narrow phase's systems: contact manifolds for the broad phase's pairs, and contact
+//! messages.
+
+use bevy_ecs::prelude::*;
+use glam::{Vec3, Vec3A};
+use parry3d::math::Pose;
+use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
+
+use crate::collision::ContactFilter;
+use crate::collision::broad_phase::BroadPhase;
+use crate::collision::narrow_phase::fetch::Wanted;
+use crate::collision::narrow_phase::points::{PointsKey, choose_changed_points};
+use crate::collision::narrow_phase::{Contacts, PairState, Recycle};
+use crate::collision::{Collider, ContactEnded, ContactSettings, ContactStarted, Sensor};
+use crate::collision::{radius, shape_pose};
+use crate::core::rest::Sleeping;
+use crate::core::time::PhysicsTime;
+use crate::particles::{LinearVelocity, Position};
+use crate::rigid::{AngularVelocity, CenterOfMass, Rotation};
+
+/// The second part's pose in the first part's frame, from the second shape's pose in the
+/// first's.
+#[inline]
+fn part_pose12(m: &crate::collision::narrow_phase::Manifold, pos12: &Pose) -> Pose {
+    match (m.subshape_pos1(), m.subshape_pos2()) {
+        (None, None) => *pos12,
+        (p1, p2) => {
+            let p1 = p1.copied().unwrap_or_default();
+            let p2 = p2.copied().unwrap_or_default();
+            p1.inverse() * *pos12 * p2
+        }
+    }
+}
+
+type NarrowCollider<'a> = (
+    Entity,
+    Ref<'a, Collider>,
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    Option<&'a LinearVelocity>,
+    Option<&'a AngularVelocity>,
+    Has<Sensor>,
+);
+
+/// What the narrow phase needs of one collider, fetched once per step however many pairs
+/// it is in.
+struct NarrowBody<'a> {
+    collider: &'a Collider,
+    pose: Pose,
+    /// Velocity of the centre of mass (m/s; zero for static colliders).
+    velocity: Vec3,
+    /// Angular velocity (rad/s; zero for static colliders).
+    spin: Vec3,
+    /// Centre of mass in the shape's frame (m).
+    centre: Vec3,
+    /// The fastest speed its spin gives any of its points, |ω| r (m/s).
+    swing: f32,
+    /// How thin the shape is (m; see [`crate::collision::narrow_phase::ccd::thickness`]).
+    thin: f32,
+    /// Fastest speed of any point of the shape (m/s): |v| + |ω| r.
+    speed: f32,
+    /// Farthest any point of the shape is from the shape's origin (m).
+    extent: f32,
+    /// The collider was replaced or changed since the last step.
+    changed: bool,
+    sensor: bool,
+    /// It has a velocity (a dynamic or kinematic body's collider, or a particle's).
+    moving: bool,
+}
+
+impl<'a> NarrowBody<'a> {
+    fn cast_side(&self) -> crate::collision::narrow_phase::ccd::CastSide<'a> {
+        crate::collision::narrow_phase::ccd::CastSide {
+            shape: &**self.collider.shape(),
+            pose: self.pose,
+            velocity: self.velocity,
+            spin: self.spin,
+            centre: self.centre,
+            swing: self.swing,
+        }
+    }
+}
+
+fn narrow_body<'a>(
+    (_, collider, x, q, com, v, w, sensor): bevy_ecs::query::ROQueryItem<'a, '_, NarrowCollider>,
+) -> NarrowBody<'a> {
+    let changed = collider.is_changed();
+    let collider = collider.into_inner();
+    let [lo, hi] = collider.local_bounds();
+    let reach = radius(collider, com);
+    let swing = w.map_or(0.0, |w| w.0.length() * reach);
+    let speed = v.map_or(0.0, |v| v.0.length()) + swing;
+    NarrowBody {
+        collider,
+        pose: shape_pose(x.0, q.0, com),
+        velocity: v.map_or(Vec3::ZERO, |v| v.0.into()),
+        spin: w.map_or(Vec3::ZERO, |w| w.0.into()),
+        centre: com.map_or(Vec3::ZERO, |c| c.0),
+        swing,
+        thin: crate::collision::narrow_phase::ccd::thickness([lo, hi]),
+        speed,
+        extent: lo.abs().max(hi.abs()).length(),
+        changed,
+        sensor,
+        moving: v.is_some(),
+    }
+}
+
+/// Runs a parry call; a panic inside it sets `failed` and gives `None`.
+#[inline]
+fn guarded<T>(failed: &mut bool, f: impl FnOnce() -> T) -> Option<T> {
+    let r = std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).ok();
+    *failed |= r.is_none();
+    r
+}
+
+/// The narrow phase's reused buffers: the bodies of the step's pairs, the pairs' slots
+/// among them, and the point list of the point choice.
+type NarrowBuffers = (Wanted, Vec<(u32, u32)>, Vec<(Vec3A, f32, bool)>);
+
+/// Persistent manifolds for every candidate pair; start/end messages.
+#[allow(clippy::too_many_arguments)] // two message writers and the queries of one pass
+pub(crate) fn update_contacts(
+    mut contacts: ResMut<Contacts>,
+    bp: Res<BroadPhase>,
+    time: Res<PhysicsTime>,
+    settings: Res<ContactSettings>,
+    colliders: Query<NarrowCollider, ContactFilter>,
+    mut started: MessageWriter<ContactStarted>,
+    mut ended: MessageWriter<ContactEnded>,
+    sleeping: Query<(), With<Sleeping>>,
+    mut buffers: Local<NarrowBuffers>,
+    mut commands: Commands,
+) {
+    let (wanted, pair_slots, scratch) = &mut *buffers;
+    wanted.clear();
+    pair_slots.clear();
+    pair_slots.extend(
+        bp.pairs
+            .iter()
+            .map(|&(a, b)| (wanted.slot(a) as u32, wanted.slot(b) as u32)),
+    );
+    let mut bodies: Vec<Option<NarrowBody>> = Vec::new();
+    bodies.resize_with(wanted.len(), || None);
+    wanted.fetch(&colliders, |c| c.0, |i, c| bodies[i] = Some(narrow_body(c)));
+    let dt = time.dt();
+    contacts.step += 1;
+    contacts.woken.clear();
+    let step = contacts.step;
+    let touch = 0.25 * settings.margin;
+    let window = match settings.recycle_distance {
+        r if r > 0.0 => r.min(settings.margin),
+        // Zero, negative or not a number: no reuse.
+        _ => 0.0,
+    };
+    for (&(a, b), &(sa, sb)) in bp.pairs.iter().zip(pair_slots.iter()) {
+        let (Some(ca), Some(cb)) = (&bodies[sa as usize], &bodies[sb as usize]) else {
+            continue;
+        };
+        let (pose_a, pose_b) = (&ca.pose, &cb.pose);
+        let sensor = ca.sensor || cb.sensor;
+        let state = contacts.pairs.entry((a, b)).or_insert_with(PairState::new);
+        state.seen = step;
+        state.sensor = sensor;
+        state.cast = None;
+        // parry can still panic on shapes at the edge of its domain (EPA's index panic was
+        // seen on huge or badly turned shapes): each parry call is guarded, and one bad pair
+        // loses its contact and its moving sides are quarantined while the step goes on.
+        let mut failed = false;
+        let touching = {
+            if sensor {
+                let (sa, sb) = (&**ca.collider.shape(), &**cb.collider.shape());
+                guarded(&mut failed, || {
+                    parry3d::query::intersection_test(pose_a, sa, pose_b, sb)
+                })
+                .is_some_and(|r| r.is_ok_and(|i| i.intersecting))
+            } else {
+                let prediction = settings.margin + (ca.speed + cb.speed) * dt;
+                let pos12 = pose_a.inverse() * *pose_b;
+                let changed = ca.changed || cb.changed;
+                match state.recycle {
+                    Some(r) if !changed && r.holds(&pos12, cb.extent, prediction, window) => {
+                        for m in &mut state.manifolds {
+                            m.update_separations(&part_pose12(m, &pos12));
+                        }
+                    }
+                    _ => {
+                        if changed {
+                            // parry reuses points itself while a pose holds still, and cannot tell
+                            // that a shape changed: start from nothing.
+                            state.manifolds.clear();
+                            state.workspace = None;
+                        }
+                        let reach = prediction + window;
+                        let before = PointsKey::of(&state.manifolds);
+                        let result = guarded(&mut failed, || {
+                            DefaultQueryDispatcher.contact_manifolds(
+                                &pos12,
+                                &**ca.collider.shape(),
+                                &**cb.collider.shape(),
+                                reach,
+                                &mut state.manifolds,
+                                &mut state.workspace,
+                            )
+                        })
+                        .unwrap_or(Err(parry3d::query::Unsupported));
+                        if result.is_err() {
+                            state.manifolds.clear();
+                        }
+                        state.recycle =
+                            (window > 0.0 && result.is_ok()).then_some(Recycle { pos12, reach });
+                        choose_changed_points(&mut state.manifolds, before, scratch);
+                    }
+                }
+                let thin = crate::collision::narrow_phase::ccd::pair_thickness(
+                    ca.thin,
+                    cb.thin,
+                    settings.margin,
+                );
+                let sweep = (cb.velocity - ca.velocity).length() + ca.swing.max(cb.swing);
+                if crate::collision::narrow_phase::ccd::is_fast(sweep, dt, thin) {
+                    let manifolds = &state.manifolds;
+                    state.cast = guarded(&mut failed, || {
+                        crate::collision::narrow_phase::ccd::impact_manifold(
+                            &ca.cast_side(),
+                            &cb.cast_side(),
+                            dt,
+                            thin,
+                            manifolds,
+                            scratch,
+                        )
+                    })
+                    .flatten()
+                    .map(Box::new);
+                }
+                state
+                    .manifolds
+                    .iter()
+                    .flat_map(|m| &m.points)
+                    .any(|p| p.dist < touch)
+            }
+        };
+        let touching = if failed {
+            state.manifolds.clear();
+            state.workspace = None;
+            state.recycle = None;
+            state.cast = None;
+            for (side, body, other) in [(a, ca, b), (b, cb, a)] {
+                if body.moving {
+                    commands
+                        .entity(side)
+                        .try_insert(crate::core::quarantine::Quarantined {
+                            reason: crate::core::quarantine::QuarantineReason::GeometryFailed {
+                                other,
+                            },
+                        });
+                }
+            }
+            false
+        } else {
+            touching
+        };
+        if touching != state.touching {
+            state.touching = touching;
+            if touching {
+                started.write(ContactStarted { a, b });
+            } else {
+                ended.write(ContactEnded { a, b });
+            }
+        }
+    }
+    let mut gone: Vec<_> = contacts
+        .pairs
+        .iter()
+        // A pair with a sleeping side is not re-formed while it sleeps, but it still
+        // touches: keep it (and its warm-start impulses) until the island wakes.
+        .filter(|((a, b), s)| s.seen != step && !(sleeping.contains(*a) || sleeping.contains(*b)))
+        .map(|(k, s)| (*k, s.touching))
+        .collect();
+    gone.sort_unstable_by_key(|g| g.0);
+    for ((a, b), touching) in gone {
+        contacts.pairs.remove(&(a, b));
+        if touching {
+            ended.write(ContactEnded { a, b });
+        }
+    }
+}
+
+/// Triggers [`crate::collision::ContactStart`] / [`crate::collision::ContactEnd`] on opted-in bodies, for the
+/// messages written since this system last ran (each message once).
+pub(crate) fn trigger_contact_events(
+    mut commands: Commands,
+    mut started: MessageReader<ContactStarted>,
+    mut ended: MessageReader<ContactEnded>,
+    enabled: Query<(), With<crate::collision::CollisionEventsEnabled>>,
+) {
+    for m in started.read() {
+        for (entity, other) in [(m.a, m.b), (m.b, m.a)] {
+            if enabled.contains(entity) {
+                commands.trigger(crate::collision::ContactStart { entity, other });
+            }
+        }
+    }
+    for m in ended.read() {
+        for (entity, other) in [(m.a, m.b), (m.b, m.a)] {
+            if enabled.contains(entity) {
+                commands.trigger(crate::collision::ContactEnd { entity, other });
+            }
+        }
+    }
+}
