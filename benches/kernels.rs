@@ -12,8 +12,8 @@ use std::hint::black_box;
 use glam::Vec3A;
 use hooke::integrator::{Rk4Scratch, drift, kick};
 use hooke::particles::fields::{advect_euler, advect_rk4};
-use hooke::scenes::jitter;
 use hooke::springs::spring_force;
+use hooke::tools::scenes::jitter;
 use timing::{Config, compare, line};
 
 fn points(n: usize, salt: usize) -> Vec<Vec3A> {

@@ -10,6 +10,9 @@
 //! Right, from the side: a 1.2 m cloth dropped on a static sphere, colliding through the node
 //! contacts, coming to rest draped.
 
+mod common;
+use common::{legend, register_fonts};
+
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -21,11 +24,8 @@ use hooke::cloth::ClothMaterial;
 use hooke::integrator::ImplicitEuler;
 use hooke::particles::VelocityField;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 use plotters::prelude::*;
-use plotters::style::{FontStyle, register_font};
-
-const FONT: &[u8] = include_bytes!("../assets/fonts/FiraSans-Regular.ttf");
 
 fn options() -> Result<(f32, PathBuf), String> {
     let (mut seconds, mut out) = (4.0f32, PathBuf::from("out/cloth.gif"));
@@ -69,8 +69,7 @@ fn flag(w: &mut World) -> Result<Entity, hooke::Error> {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (seconds, out) = options()?;
-    register_font("sans-serif", FontStyle::Normal, FONT)
-        .map_err(|_| "the bundled font did not load")?;
+    register_fonts()?;
     let g = Vec3::new(0.0, -9.81, 0.0);
     let mut windy = scenes::world_with(1.0 / 60.0, 1, Integrator::SymplecticEuler, g)?;
     windy.spawn(VelocityField::uniform(Vec3::new(0.0, 0.0, 8.0))?);
@@ -218,16 +217,5 @@ fn draw_cloth<'a, 'b: 'a>(
         .draw_series(edges)?
         .label(name.to_string())
         .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2)));
-    Ok(())
-}
-
-fn legend<'a, 'b: 'a>(chart: &mut Chart<'a, 'b>) -> Result<(), Box<dyn std::error::Error>> {
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 12))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()?;
     Ok(())
 }

@@ -31,7 +31,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     let (steps, newton) = (value("--steps", 10_000)?, value("--newton", 8)?);
-    let mut w = hooke::scenes::world_with(
+    let mut w = hooke::tools::scenes::world_with(
         1.0 / 60.0,
         1,
         Integrator::SymplecticEuler,

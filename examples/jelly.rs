@@ -10,6 +10,9 @@
 //! symplectic Euler needs 40 substeps for these materials (fewer diverge: the quarantine
 //! catches it and the frame says so).
 
+mod common;
+use common::{legend, register_fonts};
+
 use std::path::PathBuf;
 use std::time::Instant;
 
@@ -18,12 +21,9 @@ use glam::{Quat, Vec3};
 use hooke::core::quarantine::Quarantined;
 use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+use hooke::tools::scenes;
 use plotters::prelude::*;
-use plotters::style::{FontStyle, register_font};
-
-const FONT: &[u8] = include_bytes!("../assets/fonts/FiraSans-Regular.ttf");
 
 struct Options {
     model: StrainModel,
@@ -91,8 +91,7 @@ fn spawn(
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let o = options()?;
-    register_font("sans-serif", FontStyle::Normal, FONT)
-        .map_err(|_| "the bundled font did not load")?;
+    register_fonts()?;
     let substeps = if o.implicit { 1 } else { 40 };
     let mut w = scenes::world_with(
         1.0 / 60.0,
@@ -212,13 +211,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2))
             });
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font(("sans-serif", 13))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()?;
+        legend(&mut chart)?;
         root.present()?;
     }
     println!(

@@ -8,11 +8,11 @@
 mod common;
 
 use bevy_ecs::prelude::*;
-use common::register_fonts;
+use common::{legend, register_fonts};
 use hooke::collision::Contacts;
 use hooke::prelude::*;
 use hooke::rigid::Rotation;
-use hooke::scenes;
+use hooke::tools::scenes;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -112,13 +112,7 @@ where
         }))?
         .label("balls, 0.3 m radius")
         .legend(move |(x, y)| Circle::new((x + 8, y), 5, red.filled()));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 11))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()?;
+    legend(&mut chart)?;
     root.present()?;
     Ok(())
 }

@@ -9,8 +9,8 @@
 //! right: here the free end's position, in metres).
 
 use bevy_ecs::prelude::*;
-use hooke::accuracy::{Reference, Setting, Sweep, sweep};
 use hooke::prelude::*;
+use hooke::tools::accuracy::{Reference, Setting, Sweep, sweep};
 
 #[derive(Component)]
 struct Tip;

@@ -10,9 +10,9 @@
 mod common;
 
 use bevy_ecs::prelude::*;
-use common::{ramp, register_fonts};
+use common::{legend, ramp, register_fonts};
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 use plotters::prelude::*;
 
 fn xy(world: &World, e: Entity) -> (f32, f32) {
@@ -143,13 +143,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         )))?
         .label("rope anchor (pinned)")
         .legend(|(x, y)| Circle::new((x + 9, y), 4, BLACK.filled()));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 13))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .draw()?;
+    legend(&mut chart)?;
     root.present()?;
     let d = world.resource::<PhysicsDiagnostics>();
     println!("wrote {path}; last step {:?}", d.step_time);

@@ -7,7 +7,7 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::prelude::*;
-use hooke::scenes::{self, BoxSpec};
+use hooke::tools::scenes::{self, BoxSpec};
 #[path = "common/rapier_boxes.rs"]
 mod rapier_boxes;
 

@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::register_fonts;
+use common::{legend, register_fonts};
 use hooke::prelude::*;
 use hooke::rigid::AngularMomentum;
 use hooke::rigid::AngularVelocity;
@@ -17,7 +17,7 @@ use hooke::rigid::Inertia;
 use hooke::rigid::MassProperties;
 use hooke::rigid::RigidBodyBundle;
 use hooke::rigid::Rotation;
-use hooke::scenes;
+use hooke::tools::scenes;
 use plotters::prelude::*;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -75,12 +75,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .label(name)
         .legend(move |(x, y)| PathElement::new([(x, y), (x + 18, y)], color.stroke_width(2)));
     }
-    top.configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 12))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .draw()?;
+    legend(&mut top)?;
     let dev = |r: f32| 100.0 * (r - 1.0);
     let mut bottom = ChartBuilder::on(&lower)
         .caption(
@@ -118,13 +113,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ))?
         .label("|L| (exact by construction)")
         .legend(|(x, y)| PathElement::new([(x, y), (x + 18, y)], BLACK));
-    bottom
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperRight)
-        .label_font(("sans-serif", 12))
-        .background_style(WHITE.mix(0.9))
-        .border_style(BLACK)
-        .draw()?;
+    legend(&mut bottom)?;
     root.present()?;
 
     let flips = samples

@@ -128,9 +128,9 @@
 //!
 //! ## Scenarios and tests
 //!
-//! [`scenario`] runs RON files that build a scene, act on it on a timeline and check
+//! [`tools::scenario`] runs RON files that build a scene, act on it on a timeline and check
 //! expectations (the `hooke` command with the `cli` feature runs them from a shell);
-//! [`testing`] has the helpers a `#[test]` steps a world with.
+//! [`tools::testing`] has the helpers a `#[test]` steps a world with.
 //!
 //! ## Order
 //!
@@ -144,7 +144,6 @@
 
 #![warn(missing_docs)]
 
-pub mod accuracy;
 #[cfg(feature = "bevy")]
 pub mod bevy;
 pub mod cloth;
@@ -154,13 +153,12 @@ pub mod integrator;
 pub mod particles;
 mod plugins;
 pub mod rigid;
-pub mod scenario;
-pub mod scenes;
 pub mod sleep;
 pub mod snapshot;
 pub mod soft;
 pub mod springs;
-pub mod testing;
+#[cfg(feature = "tools")]
+pub mod tools;
 
 /// parry, re-exported so custom shapes ([`Collider::new`]) need no second dependency.
 pub use parry3d;

@@ -4,10 +4,10 @@ use std::time::Instant;
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use hooke::accuracy::{Measurement, Setting, SweepReport, world_for};
 use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
 use hooke::soft::{Material, StrainModel};
+use hooke::tools::accuracy::{Measurement, Setting, SweepReport, world_for};
 
 use crate::problems::Problem;
 
@@ -23,7 +23,7 @@ fn deflection(cells: [usize; 3], model: StrainModel) -> hooke::Result<(f64, f64)
         max_cg: 5000,
         ..ImplicitEuler::default()
     };
-    let beam = hooke::scenes::Cantilever::spawn(&mut w, cells, model, settings)?;
+    let beam = hooke::tools::scenes::Cantilever::spawn(&mut w, cells, model, settings)?;
     let t0 = Instant::now();
     w.step_physics();
     let spent = t0.elapsed().as_secs_f64();
@@ -100,8 +100,13 @@ pub fn swinging_beam(quick: bool) -> hooke::Result<Problem> {
         w.insert_resource(Gravity::new(Vec3::new(0.0, -9.81, 0.0))?);
         w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
         let material = Material::new(1e5, 0.3, 1000.0)?;
-        let (nodes, body) =
-            hooke::scenes::pinned_beam(1.0, 0.2, [5, 1, 1], material, StrainModel::Corotated)?;
+        let (nodes, body) = hooke::tools::scenes::pinned_beam(
+            1.0,
+            0.2,
+            [5, 1, 1],
+            material,
+            StrainModel::Corotated,
+        )?;
         let tip = (0..nodes.len())
             .filter(|&i| (nodes.positions()[i].x - 1.0).abs() < 1e-5)
             .collect();
@@ -119,12 +124,12 @@ pub fn swinging_beam(quick: bool) -> hooke::Result<Problem> {
             })
             .collect()
     };
-    let report = hooke::accuracy::sweep(
+    let report = hooke::tools::accuracy::sweep(
         build,
         tip,
         &crate::problems::settings(),
-        hooke::accuracy::Reference::Converged(Setting::new(Integrator::Rk4, 64)),
-        hooke::accuracy::Sweep::seconds(1.5).with_timing_runs(if quick { 1 } else { 7 }),
+        hooke::tools::accuracy::Reference::Converged(Setting::new(Integrator::Rk4, 64)),
+        hooke::tools::accuracy::Sweep::seconds(1.5).with_timing_runs(if quick { 1 } else { 7 }),
     )?;
     Ok(Problem::new(
         "FEM beam swinging (co-rotated, E = 1e5)",

@@ -9,6 +9,10 @@
 //!
 //! Writes `out/accuracy.png`, `out/accuracy.svg` and `out/accuracy.md`, and prints the table.
 
+#[path = "../common/mod.rs"]
+mod common;
+use common::register_fonts;
+
 mod chart;
 mod fem;
 mod problems;
@@ -19,13 +23,10 @@ use std::time::Instant;
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use hooke::accuracy::{Reference, Setting, Sweep, order, sweep};
 use hooke::prelude::*;
+use hooke::tools::accuracy::{Reference, Setting, Sweep, order, sweep};
 use plotters::prelude::*;
-use plotters::style::{FontStyle, register_font};
 use problems::Problem;
-
-const FONT: &[u8] = include_bytes!("../../assets/fonts/FiraSans-Regular.ttf");
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let quick = std::env::args().any(|a| a == "--quick");
@@ -62,8 +63,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("{md}");
     std::fs::create_dir_all("out")?;
     std::fs::write("out/accuracy.md", &md)?;
-    register_font("sans-serif", FontStyle::Normal, FONT)
-        .map_err(|_| "the bundled font did not load")?;
+    register_fonts()?;
     let size = (1920, 1560);
     chart::draw(
         &BitMapBackend::new(Path::new("out/accuracy.png"), size).into_drawing_area(),
@@ -160,7 +160,7 @@ fn orders() -> hooke::Result<String> {
     let build = |w: &mut World| -> hooke::Result<()> {
         w.insert_resource(Gravity::new(Vec3::ZERO)?);
         let tau = std::f32::consts::TAU;
-        let b = hooke::scenes::oscillator(w, 1.0, tau * tau, 0.0, 1.0)?;
+        let b = hooke::tools::scenes::oscillator(w, 1.0, tau * tau, 0.0, 1.0)?;
         w.entity_mut(b).insert(Bob);
         Ok(())
     };

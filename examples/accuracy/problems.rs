@@ -2,7 +2,6 @@
 
 use bevy_ecs::prelude::*;
 use glam::{DQuat, DVec2, DVec3, Quat, Vec3};
-use hooke::accuracy::{Measurement, Reference, Setting, Sweep, SweepReport, sweep, timed_run};
 use hooke::collision::Collider;
 use hooke::collision::Friction;
 use hooke::collision::Restitution;
@@ -13,8 +12,11 @@ use hooke::rigid::MassProperties;
 use hooke::rigid::OrientationUpdate;
 use hooke::rigid::RigidBodyBundle;
 use hooke::rigid::Rotation;
-use hooke::scenes;
 use hooke::springs::StabilityPolicy;
+use hooke::tools::accuracy::{
+    Measurement, Reference, Setting, Sweep, SweepReport, sweep, timed_run,
+};
+use hooke::tools::scenes;
 
 /// One problem's sweep, with how its error is measured.
 pub struct Problem {

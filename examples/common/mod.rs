@@ -3,16 +3,15 @@
 //! `plotters` and encoded by its `image` (PNG) and `gif` backends.
 #![allow(dead_code)]
 
-use plotters::style::{FontStyle, RGBColor, register_font};
+use plotters::style::RGBColor;
 
-const FONT: &[u8] = include_bytes!("../../assets/fonts/FiraSans-Regular.ttf");
+/// The library's chart helpers (`hooke::tools::plot`, feature `plot`), compiled here from the
+/// same source so the examples need no feature.
+#[path = "../../src/tools/plot.rs"]
+pub mod plot;
 
-/// Registers the bundled Fira Sans as "sans-serif".
-pub fn register_fonts() -> Result<(), Box<dyn std::error::Error>> {
-    register_font("sans-serif", FontStyle::Normal, FONT)
-        .map_err(|_| "the bundled font did not load")?;
-    Ok(())
-}
+#[allow(unused_imports)] // each example uses some
+pub use plot::{axes, legend, register_fonts};
 
 /// A colour ramp from blue (0) to orange (1).
 pub fn ramp(t: f32) -> RGBColor {

@@ -1,7 +1,7 @@
 //! The contact scenes built in rapier 0.36 from the same specs hooke spawns, for the
 //! side-by-side examples.
 
-use hooke::scenes::BoxSpec;
+use hooke::tools::scenes::BoxSpec;
 use rapier3d::prelude as rp;
 
 /// A rapier world at dt = 1/60 and its defaults, with `specs` as cuboids of density

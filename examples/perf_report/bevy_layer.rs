@@ -9,7 +9,7 @@ use bevy_ecs::prelude::*;
 use bevy_time::{Fixed, Time, TimePlugin, TimeUpdateStrategy};
 use bevy_transform::TransformPlugin;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 use crate::timing::{Config, compare, line};
 

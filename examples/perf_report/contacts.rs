@@ -7,7 +7,7 @@ use std::time::Instant;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::prelude::*;
-use hooke::scenes::{self, BoxSpec};
+use hooke::tools::scenes::{self, BoxSpec};
 use rapier3d::prelude as rp;
 
 use crate::timing::{Config, compare, line, median};

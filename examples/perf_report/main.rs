@@ -29,7 +29,7 @@ use std::time::Instant;
 use bevy_ecs::prelude::*;
 use glam::Vec3A;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 use timing::{Config, compare, line};
 
 /// A world with every plugin and gravity, without the energy pass: the setup of every

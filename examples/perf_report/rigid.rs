@@ -7,7 +7,7 @@ use hooke::prelude::*;
 use hooke::rigid::Inertia;
 use hooke::rigid::MassProperties;
 use hooke::rigid::free_rotation_split;
-use hooke::scenes;
+use hooke::tools::scenes;
 use parry3d::shape::Cuboid;
 use rapier3d::prelude as rp;
 

@@ -7,8 +7,8 @@ use std::hint::black_box;
 
 use bevy_ecs::prelude::*;
 use hooke::prelude::*;
-use hooke::scenario::Scenario;
-use hooke::scenes;
+use hooke::tools::scenario::Scenario;
+use hooke::tools::scenes;
 
 use crate::timing::{Config, compare, line};
 

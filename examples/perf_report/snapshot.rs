@@ -6,8 +6,8 @@ use std::hint::black_box;
 
 use bevy_ecs::prelude::*;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::snapshot::Snapshot;
+use hooke::tools::scenes;
 
 use crate::timing::{Config, compare, line};
 

@@ -8,8 +8,8 @@ use bevy_ecs::prelude::*;
 use glam::{Mat3, Vec3, Vec3A};
 use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+use hooke::tools::scenes;
 
 use crate::timing::{Config, compare, line};
 

@@ -17,12 +17,10 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use hooke::scenario::{Report, RunOptions, Scenario};
+use hooke::tools::plot::{axes, legend, register_fonts};
+use hooke::tools::scenario::{Report, RunOptions, Scenario};
 use indicatif::{ProgressBar, ProgressStyle};
 use plotters::prelude::*;
-use plotters::style::{FontStyle, register_font};
-
-const FONT: &[u8] = include_bytes!("../../assets/fonts/FiraSans-Regular.ttf");
 
 const USAGE: &str =
     "usage: hooke run [--csv DIR] [--plot DIR] [--quiet] FILE...\n       hooke check FILE...";
@@ -215,8 +213,7 @@ fn pin(path: &Path, report: &Report) -> Result<(), Box<dyn std::error::Error>> {
 /// Height and speed of each traced entity against time, one panel each.
 fn plot(report: &Report, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
     // A second registration (several files in one run) is harmless.
-    register_font("sans-serif", FontStyle::Normal, FONT)
-        .map_err(|_| "the bundled font did not load")?;
+    register_fonts()?;
     let root = BitMapBackend::new(out, (1000, 760)).into_drawing_area();
     root.fill(&WHITE)?;
     let verdict = if report.passed() {
@@ -260,12 +257,7 @@ fn plot(report: &Report, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
             .x_label_area_size(34)
             .y_label_area_size(58)
             .build_cartesian_2d(0.0..t_end, (lo - pad)..(hi + pad))?;
-        chart
-            .configure_mesh()
-            .x_desc("t (s)")
-            .y_desc(unit)
-            .label_style(("sans-serif", 12))
-            .draw()?;
+        axes(&mut chart, "t (s)", unit)?;
         for (i, t) in report.traces.iter().enumerate() {
             let color = colors[i % colors.len()];
             chart
@@ -282,13 +274,7 @@ fn plot(report: &Report, out: &Path) -> Result<(), Box<dyn std::error::Error>> {
                 });
         }
         if !report.traces.is_empty() {
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
-                .label_font(("sans-serif", 12))
-                .background_style(WHITE.mix(0.9))
-                .border_style(BLACK)
-                .draw()?;
+            legend(&mut chart)?;
         }
     }
     root.present()?;

@@ -3,7 +3,7 @@
 
 use bevy_ecs::prelude::*;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 pub const TWO_PI: f32 = std::f32::consts::TAU;
 

@@ -1,5 +1,6 @@
 //! hooke's integration tests: one binary, a module per subject.
 
+mod architecture;
 mod bevy;
 mod cloth;
 mod collision;

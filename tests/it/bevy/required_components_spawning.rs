@@ -13,7 +13,7 @@ use hooke::collision::ColliderOffset;
 use hooke::core::quarantine::QuarantineReason;
 use hooke::prelude::*;
 use hooke::rigid::CenterOfMass;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 use crate::common;
 

@@ -11,7 +11,7 @@ use hooke::cloth::ClothMaterial;
 use hooke::core::quarantine::Quarantined;
 use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 fn world(substeps: u32, g: Vec3) -> World {
     let mut w = scenes::world_with(1.0 / 60.0, substeps, Integrator::SymplecticEuler, g).unwrap();

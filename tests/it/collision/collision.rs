@@ -14,7 +14,7 @@ use hooke::collision::Sensor;
 use hooke::prelude::*;
 use hooke::rigid::RigidBodyBundle;
 use hooke::rigid::Rotation;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 const G: f32 = 9.81;
 

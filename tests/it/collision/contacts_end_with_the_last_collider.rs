@@ -7,7 +7,7 @@ use bevy_ecs::message::Messages;
 use hooke::collision::ContactEnded;
 use hooke::collision::Contacts;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 use crate::common;
 

@@ -10,7 +10,7 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 struct Recovery {
     lowest_ever: f32,

@@ -11,7 +11,7 @@ use glam::Vec3;
 use hooke::collision::ContactSettings;
 use hooke::core::diagnostics::PhysicsDiagnostics;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 /// A unit box (1000 kg) with its centre at height `y`, spinning at `omega` (rad/s).
 fn spinning_box(w: &mut World, y: f32, omega: Vec3) -> Entity {

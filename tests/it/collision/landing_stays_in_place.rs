@@ -6,7 +6,7 @@
 
 use glam::{Quat, Vec3};
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 use crate::common;
 

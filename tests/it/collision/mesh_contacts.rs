@@ -5,7 +5,7 @@
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 use crate::common;
 

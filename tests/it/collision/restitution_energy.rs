@@ -10,7 +10,7 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 fn world(g: Vec3) -> World {
     let mut w = scenes::world_with(1.0 / 60.0, 4, Integrator::SymplecticEuler, g).unwrap();

@@ -6,7 +6,7 @@
 use glam::Vec3;
 use hooke::collision::RestitutionThreshold;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 /// Drops a 0.1 m ball from 1 m (e = 0.8 on ball and ground) for `seconds`; its apex heights
 /// above the ground (m), one per bounce.

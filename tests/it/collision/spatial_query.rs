@@ -7,7 +7,7 @@ use hooke::collision::Collider;
 use hooke::collision::Sensor;
 use hooke::collision::{QueryFilter, SpatialQuery};
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 fn scene() -> (World, Entity, Entity) {
     let mut w = scenes::world_with(1.0 / 60.0, 4, Integrator::SymplecticEuler, Vec3::ZERO).unwrap();

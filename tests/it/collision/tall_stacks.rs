@@ -19,7 +19,7 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 /// How far the top of a column `n` boxes high sank and the farthest it strayed from the
 /// column's axis over `seconds` (m), sleeping off.

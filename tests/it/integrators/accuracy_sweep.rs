@@ -1,11 +1,11 @@
-//! The accuracy dial's API (`hooke::accuracy`) against the oscillator's exact discrete
+//! The accuracy dial's API (`hooke::tools::accuracy`) against the oscillator's exact discrete
 //! solutions and the integrators' orders.
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use hooke::accuracy::{Measurement, Reference, Setting, Sweep, SweepReport, order, sweep};
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::accuracy::{Measurement, Reference, Setting, Sweep, SweepReport, order, sweep};
+use hooke::tools::scenes;
 
 const OMEGA: f64 = std::f64::consts::TAU;
 

@@ -161,7 +161,8 @@ fn per_body_override_matches_a_world_using_that_integrator() {
         x(&world, body)
     };
     let (mut world, plain) = oscillator(1.0 / 60.0, Integrator::SymplecticEuler, 0.0);
-    let special = hooke::scenes::oscillator(&mut world, 1.0, TWO_PI * TWO_PI, 0.0, 1.0).unwrap();
+    let special =
+        hooke::tools::scenes::oscillator(&mut world, 1.0, TWO_PI * TWO_PI, 0.0, 1.0).unwrap();
     world
         .entity_mut(special)
         .insert(IntegratorOverride(Integrator::Rk4));

@@ -11,7 +11,7 @@ use hooke::core::schedule::{ForceSystems, add_force_systems};
 use hooke::core::whole_step::FusedSubsteps;
 use hooke::prelude::*;
 use hooke::rigid::{AngularMomentum, ExternalTorque, Torque};
-use hooke::scenes;
+use hooke::tools::scenes;
 
 /// Bits of every body's x, q, v, L, ω and force and torque accumulators, by entity.
 fn state(world: &mut World) -> Vec<(Entity, Vec<u32>)> {

@@ -4,7 +4,7 @@ use crate::common;
 
 use common::*;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 const G: f32 = 9.81;
 

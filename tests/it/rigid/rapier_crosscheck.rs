@@ -8,7 +8,7 @@ use hooke::rigid::Inertia;
 use hooke::rigid::MassProperties;
 use hooke::rigid::RigidBodyBundle;
 use hooke::rigid::Rotation;
-use hooke::scenes;
+use hooke::tools::scenes;
 use parry3d::shape::SharedShape;
 use rapier3d::prelude as rp;
 

@@ -17,7 +17,7 @@ use hooke::rigid::RigidBody;
 use hooke::rigid::RigidBodyBundle;
 use hooke::rigid::Rotation;
 use hooke::rigid::SkipRenormalization;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 fn world(dt: f32, substeps: u32, integrator: Integrator) -> World {
     scenes::world_with(dt, substeps, integrator, Vec3::ZERO).unwrap()

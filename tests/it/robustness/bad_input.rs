@@ -6,7 +6,7 @@ use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 use common::*;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 fn world() -> World {
     scenes::world_with(

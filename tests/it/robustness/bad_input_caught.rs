@@ -12,8 +12,8 @@ use hooke::core::time::SubstepTime;
 use hooke::parry3d::shape::SharedShape;
 use hooke::prelude::*;
 use hooke::rigid::AngularMomentum;
-use hooke::scenes;
 use hooke::sleep::SleepSettings;
+use hooke::tools::scenes;
 
 fn world() -> World {
     scenes::world_with(

@@ -7,8 +7,8 @@ use hooke::collision::ColliderAabb;
 use hooke::collision::ContactSettings;
 use hooke::particles::GravityScale;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::snapshot::Snapshot;
+use hooke::tools::scenes;
 
 /// A plate spun to 2.7e11 rad/s next to a ball, two more spinners and a jelly: a body was
 /// flung to 2e8 m within one step while the step's last pass left it slow, and it stayed

@@ -13,9 +13,9 @@ use hooke::particles::ExternalImpulse;
 use hooke::prelude::*;
 use hooke::rigid::AngularVelocity;
 use hooke::rigid::KinematicTarget;
-use hooke::scenes;
 use hooke::snapshot::Snapshot;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+use hooke::tools::scenes;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestCaseError, TestError, TestRng, TestRunner};
 

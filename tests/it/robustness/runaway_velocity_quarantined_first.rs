@@ -6,8 +6,8 @@
 
 use bevy_ecs::prelude::*;
 use hooke::prelude::*;
-use hooke::scenes;
-use hooke::testing::PhysicsTestExt;
+use hooke::tools::scenes;
+use hooke::tools::testing::PhysicsTestExt;
 
 fn crate_at(world: &mut World, x: Vec3) -> Entity {
     scenes::dynamic_box(world, Vec3::splat(0.5), x).unwrap()

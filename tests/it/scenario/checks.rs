@@ -2,7 +2,7 @@
 //! expectation that must hold and one that must fail, so a check that can never fail (or
 //! never pass) is caught.
 
-use hooke::scenario::{Report, Scenario};
+use hooke::tools::scenario::{Report, Scenario};
 
 /// Runs a scenario whose entities are `entities`, with `timeline` and `expect` lists.
 fn run(settings: &str, entities: &str, timeline: &str, expect: &str) -> Report {

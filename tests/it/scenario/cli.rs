@@ -70,7 +70,7 @@ fn traces_and_a_plot_are_written_on_request() {
     );
     let trace = std::fs::read_to_string(csv.join("bounce_ball.csv")).unwrap();
     let mut lines = trace.lines();
-    assert_eq!(lines.next(), Some(hooke::scenario::Trace::HEADER));
+    assert_eq!(lines.next(), Some(hooke::tools::scenario::Trace::HEADER));
     // One row per step, 0 to 180.
     assert_eq!(lines.count(), 181);
     let bytes = std::fs::read(png.join("bounce.png")).unwrap();

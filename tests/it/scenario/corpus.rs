@@ -2,7 +2,7 @@
 //! holds (CI also runs it through the `hooke` command). It is the project's regression
 //! corpus: a file that pins its final-state hash fails when results change.
 
-use hooke::scenario::Scenario;
+use hooke::tools::scenario::Scenario;
 
 #[test]
 fn every_corpus_scenario_passes() {

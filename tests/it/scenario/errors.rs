@@ -1,7 +1,7 @@
 //! Every kind of bad scenario file is a typed error with its line, never a panic: one file
 //! per case in `tests/scenarios/`.
 
-use hooke::scenario::{Scenario, ScenarioError, ScenarioErrorKind};
+use hooke::tools::scenario::{Scenario, ScenarioError, ScenarioErrorKind};
 
 fn load(name: &str) -> Result<Scenario, ScenarioError> {
     Scenario::from_file(format!(

@@ -8,7 +8,7 @@ use hooke::core::schedule::ForceSchedule;
 use hooke::core::schedule::PhysicsSchedule;
 use hooke::core::schedule::SubstepSchedule;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 fn assert_no_ambiguities(world: &mut World, label: impl ScheduleLabel + Clone) {
     let result = world.schedule_scope(label.clone(), |world, schedule| {

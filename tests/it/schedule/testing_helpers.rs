@@ -1,8 +1,8 @@
-//! `hooke::testing`: runs counted in whole steps, and short reads of a body's state.
+//! `hooke::tools::testing`: runs counted in whole steps, and short reads of a body's state.
 
 use bevy_ecs::prelude::*;
 use hooke::prelude::*;
-use hooke::testing::PhysicsTestExt;
+use hooke::tools::testing::PhysicsTestExt;
 
 fn world() -> World {
     let mut w = World::new();
@@ -88,7 +88,7 @@ fn bad_times_and_worlds_without_physics_are_errors() {
 fn rigid_accessors_read_pose_and_spin() {
     let mut w = world();
     w.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
-    let b = hooke::scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::Y).unwrap();
+    let b = hooke::tools::scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::Y).unwrap();
     w.get_mut::<AngularVelocity>(b).unwrap().0 = Vec3A::new(0.0, 1.0, 0.0);
     w.run_for_seconds(1.0).unwrap();
     let (angle_axis, angle) = w.rotation_of(b).unwrap().to_axis_angle();

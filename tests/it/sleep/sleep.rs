@@ -5,8 +5,8 @@ use glam::Vec3;
 use hooke::core::rest::Sleeping;
 use hooke::core::rest::SleepingDisabled;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::sleep::SleepSettings;
+use hooke::tools::scenes;
 
 use crate::common;
 

@@ -9,7 +9,7 @@ use glam::Vec3;
 use hooke::collision::Contacts;
 use hooke::core::rest::Sleeping;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 /// A 5-box column of unit boxes on the ground at the defaults, asleep.
 fn sleeping_stack() -> (World, Entity, Vec<Entity>) {

@@ -6,7 +6,7 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::core::rest::Sleeping;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 use crate::common;
 

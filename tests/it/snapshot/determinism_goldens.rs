@@ -17,8 +17,8 @@
 
 use bevy_ecs::prelude::*;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::snapshot::Snapshot;
+use hooke::tools::scenes;
 
 const FILE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/goldens/determinism.txt");
 

@@ -5,8 +5,8 @@
 use bevy_ecs::prelude::*;
 use hooke::prelude::*;
 use hooke::rigid::AngularMomentum;
-use hooke::scenes;
 use hooke::snapshot::{EntityMap, FORMAT_VERSION, Snapshot, SnapshotError};
+use hooke::tools::scenes;
 
 /// Every bit of the simulated state of `entities` (poses, velocities, mesh nodes, sleep).
 fn state_bits(world: &World, entities: impl Iterator<Item = Entity>) -> Vec<u32> {

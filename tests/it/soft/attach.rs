@@ -10,8 +10,8 @@ use hooke::prelude::*;
 use hooke::rigid::AngularMomentum;
 use hooke::rigid::Inertia;
 use hooke::rigid::RigidBody;
-use hooke::scenes;
 use hooke::soft::{CellSplit, Material, NodeAttachments, SoftBody, StrainModel, TetMesh};
+use hooke::tools::scenes;
 
 fn world(g: Vec3) -> World {
     let mut w = scenes::world_with(1.0 / 60.0, 1, Integrator::SymplecticEuler, g).unwrap();

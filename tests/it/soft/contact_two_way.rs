@@ -10,8 +10,8 @@ use hooke::integrator::ImplicitEuler;
 use hooke::particles::GravityScale;
 use hooke::prelude::*;
 use hooke::rigid::RigidBody;
-use hooke::scenes;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+use hooke::tools::scenes;
 
 fn world(g: Vec3, substeps: u32) -> World {
     let mut w = scenes::world_with(1.0 / 60.0, substeps, Integrator::SymplecticEuler, g).unwrap();

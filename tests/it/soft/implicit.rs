@@ -5,8 +5,8 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+use hooke::tools::scenes;
 
 fn world(g: Vec3, dt: f32, substeps: u32) -> World {
     let mut w = scenes::world_with(dt, substeps, Integrator::SymplecticEuler, g).unwrap();

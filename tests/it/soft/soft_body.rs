@@ -5,8 +5,8 @@ use bevy_ecs::prelude::*;
 use glam::{DVec3, Mat3, Vec3, Vec3A};
 use hooke::Error;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+use hooke::tools::scenes;
 
 #[test]
 fn meshes_are_validated() {

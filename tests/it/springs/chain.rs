@@ -136,7 +136,7 @@ fn a_rope_between_two_pins_hangs_on_the_catenary() {
         let m = probe.resource::<bevy_ecs::message::Messages<hooke::springs::StabilityWarning>>();
         m.get_cursor().read(m).next().unwrap().substeps_needed
     };
-    let mut w = hooke::scenes::world_with(
+    let mut w = hooke::tools::scenes::world_with(
         1.0 / 60.0,
         needed,
         Integrator::SymplecticEuler,
@@ -156,7 +156,7 @@ fn a_rope_between_two_pins_hangs_on_the_catenary() {
         .map(|&n| w.get::<Position>(n).unwrap().0.y)
         .fold(f32::INFINITY, f32::min);
     let sag = 3.0 - lowest;
-    let a = hooke::scenes::catenary_parameter(f64::from(span), f64::from(length));
+    let a = hooke::tools::scenes::catenary_parameter(f64::from(span), f64::from(length));
     let c = (f64::from(span) / (2.0 * a)).cosh();
     let closed_sag = (a * (c - 1.0)) as f32;
     // The pinned ends carry half a node's weight each less than the rope's: w per rest length.
@@ -222,7 +222,7 @@ fn a_taut_strings_transverse_waves_travel_at_the_square_root_of_tension_over_den
     }
     let limit = net.critical_step(&nodes);
     let substeps = ((1.0 / 60.0) / (0.5 * limit)).ceil() as u32;
-    let mut w = hooke::scenes::world_with(
+    let mut w = hooke::tools::scenes::world_with(
         1.0 / 60.0,
         substeps,
         Integrator::SymplecticEuler,

@@ -3,7 +3,7 @@
 //! be stable at the default step; the cloth, with 2 substeps as documented.
 
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 #[test]
 fn rope_and_hair_defaults_are_stable_at_60_hz_one_substep() {

@@ -11,10 +11,10 @@ use hooke::core::quarantine::Quarantined;
 use hooke::core::time::PhysicsTime;
 use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::springs::ChainBuilder;
 use hooke::springs::StabilityPolicy;
 use hooke::springs::StabilityWarning;
+use hooke::tools::scenes;
 
 fn warnings(w: &World) -> Vec<StabilityWarning> {
     let m = w.resource::<Messages<StabilityWarning>>();

@@ -11,7 +11,7 @@ use hooke::core::quarantine::Quarantined;
 use hooke::integrator::ImplicitEuler;
 use hooke::integrator::ImplicitState;
 use hooke::prelude::*;
-use hooke::scenes;
+use hooke::tools::scenes;
 
 fn world(dt: f32, substeps: u32, g: Vec3) -> World {
     let mut w = scenes::world_with(dt, substeps, Integrator::SymplecticEuler, g).unwrap();

@@ -5,8 +5,8 @@ use crate::common;
 use common::*;
 use glam::Vec3A;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::springs::spring_force;
+use hooke::tools::scenes;
 
 #[test]
 fn force_law_equals_the_lecture_formula() {

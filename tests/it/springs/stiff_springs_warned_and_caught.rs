@@ -15,9 +15,9 @@ use hooke::core::quarantine::QuarantineReason;
 use hooke::core::quarantine::Quarantined;
 use hooke::core::time::PhysicsTime;
 use hooke::prelude::*;
-use hooke::scenes;
 use hooke::springs::SpringStability;
 use hooke::springs::StabilityWarning;
+use hooke::tools::scenes;
 
 /// The defaults, but springs past their limit stay explicit.
 fn default_world() -> World {

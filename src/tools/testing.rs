@@ -9,7 +9,7 @@
 //! ```
 //! use bevy_ecs::prelude::*;
 //! use hooke::prelude::*;
-//! use hooke::testing::PhysicsTestExt;
+//! use hooke::tools::testing::PhysicsTestExt;
 //!
 //! let mut world = World::new();
 //! world.add_physics(PhysicsPlugins);

@@ -16,7 +16,7 @@
 //!
 //! ```no_run
 //! use bevy_ecs::prelude::*;
-//! use hooke::accuracy::{sweep, Reference, Setting, Sweep};
+//! use hooke::tools::accuracy::{sweep, Reference, Setting, Sweep};
 //! use hooke::prelude::*;
 //!
 //! # fn main() -> hooke::Result<()> {

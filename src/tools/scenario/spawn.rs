@@ -23,9 +23,9 @@ use crate::particles::VelocityField;
 use crate::rigid::AngularVelocity;
 use crate::rigid::RigidBody;
 use crate::rigid::Rotation;
-use crate::scenes;
 use crate::springs::ChainBuilder;
 use crate::springs::Spring;
+use crate::tools::scenes;
 
 /// Spawns `spawn`; `lookup` resolves the names a spring's ends use to one entity.
 pub(super) fn spawn(

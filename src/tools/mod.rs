@@ -1,0 +1,16 @@
+//! Tools on top of the physics: nothing below names them, and the physics compiles without
+//! them (the default `tools` feature).
+//!
+//! - [`scenes`]: the scene builders shared by tests, examples, benchmarks and scenarios;
+//! - [`scenario`]: RON files that build a scene, act on it on a timeline and check
+//!   expectations (the `hooke` command runs them, with the `cli` feature);
+//! - [`accuracy`]: the accuracy sweep, error against closed forms for each setting of the dial;
+//! - [`testing`]: helpers a `#[test]` steps a world with;
+//! - `plot` (feature `plot`): the font, axes and legend every chart of hooke's shares.
+
+pub mod accuracy;
+#[cfg(feature = "plot")]
+pub mod plot;
+pub mod scenario;
+pub mod scenes;
+pub mod testing;

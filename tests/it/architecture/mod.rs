@@ -1,0 +1,3 @@
+//! The house: layers as folders, imports flowing down, no import circles.
+
+mod layers;
