@@ -30,24 +30,25 @@
 //!
 //! | plugin | what | acts on |
 //! |---|---|---|
-//! | [`PhysicsCorePlugin`] (always) | schedules, time, integrators, external forces and impulses, quarantine, diagnostics | everything |
-//! | [`GravityPlugin`] | f = m g s | [`Mass`], [`Nodes`] |
-//! | [`DampingPlugin`] | f = −c m v | [`LinearDamping`] |
-//! | [`VelocityFieldPlugin`] | dx/dt = Σ u(x, t) | [`Tracer`], [`VelocityField`] |
-//! | [`SpringPlugin`] | damped springs | [`Spring`], [`SpringNetwork`] |
-//! | [`RigidBodyPlugin`] | orientation, angular momentum, torque, renormalisation | [`Inertia`] ([`RigidBody`]) |
-//! | [`CollisionPlugin`] | broad and narrow phase, contact solver, contact messages, [`SpatialQuery`], mass from colliders, child colliders | [`Collider`] |
-//! | [`SleepPlugin`] | resting islands stop costing anything | [`Collider`] bodies |
+//! | [`PhysicsCorePlugin`](crate::core::plugin::PhysicsCorePlugin) (always) | the kernel: schedules, time, quarantine, restored resources, diagnostics | everything |
+//! | [`IntegratorPlugin`](crate::integrator::IntegratorPlugin) (always) | the integrator dial, external forces and impulses, the divergence guard | [`Mass`](crate::particles::Mass), [`Nodes`](crate::particles::Nodes) |
+//! | [`GravityPlugin`](crate::particles::GravityPlugin) | f = m g s | [`Mass`](crate::particles::Mass), [`Nodes`](crate::particles::Nodes) |
+//! | [`DampingPlugin`](crate::particles::DampingPlugin) | f = −c m v | [`LinearDamping`](crate::particles::LinearDamping) |
+//! | [`VelocityFieldPlugin`](crate::particles::VelocityFieldPlugin) | dx/dt = Σ u(x, t) | [`Tracer`](crate::particles::Tracer), [`VelocityField`](crate::particles::VelocityField) |
+//! | [`SpringPlugin`](crate::springs::SpringPlugin) | damped springs | [`Spring`](crate::springs::Spring), [`SpringNetwork`](crate::springs::SpringNetwork) |
+//! | [`RigidBodyPlugin`](crate::rigid::RigidBodyPlugin) | orientation, angular momentum, torque, renormalisation | [`Inertia`](crate::rigid::Inertia) ([`RigidBody`](crate::rigid::RigidBody)) |
+//! | [`CollisionPlugin`](crate::collision::CollisionPlugin) | broad and narrow phase, contact solver, contact messages, [`SpatialQuery`](crate::collision::SpatialQuery), mass from colliders, child colliders | [`Collider`](crate::collision::Collider) |
+//! | [`SleepPlugin`](crate::sleep::SleepPlugin) | resting islands stop costing anything | [`Collider`](crate::collision::Collider) bodies |
 //! | [`soft::SoftBodyPlugin`] | tetrahedral FEM: elastic forces of the four strain models | [`soft::SoftBody`] |
 //! | [`cloth::ClothPlugin`] | wind on triangles, strain limiting, node collisions, vertex normals | [`cloth::Cloth`] |
 //!
 //! With the `bevy` feature, [`PhysicsPlugins`] is also a Bevy `PluginGroup`, every plugin above
-//! a Bevy `Plugin`, and [`bevy`] adds the App clock, `Transform` sync, interpolation and
+//! a Bevy `Plugin`, and the `bevy` module adds the App clock, `Transform` sync, interpolation and
 //! diagnostics plugins.
 //!
 //! | feature | default | what |
 //! |---|---|---|
-//! | `bevy` | off | `bevy_app`, `bevy_time`, `bevy_transform`, `bevy_diagnostic` 0.20: see [`bevy`] |
+//! | `bevy` | off | `bevy_app`, `bevy_time`, `bevy_transform`, `bevy_diagnostic` 0.20: the `bevy` module |
 //!
 //! ## Spawning
 //!
@@ -134,7 +135,7 @@
 //!
 //! ## Order
 //!
-//! [`schedule`] declares it, once: clear forces → apply forces → accumulate torque →
+//! [`core::schedule`] declares it, once: clear forces → apply forces → accumulate torque →
 //! integrate velocities → solve constraints → integrate positions → complete stages →
 //! renormalise, repeated `substeps` times per step.
 //!
@@ -160,7 +161,7 @@ pub mod springs;
 #[cfg(feature = "tools")]
 pub mod tools;
 
-/// parry, re-exported so custom shapes ([`Collider::new`]) need no second dependency.
+/// parry, re-exported so custom shapes ([`Collider::new`](crate::collision::Collider::new)) need no second dependency.
 pub use parry3d;
 
 pub use core::error::{Error, Result};

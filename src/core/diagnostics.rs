@@ -30,13 +30,13 @@ use crate::core::schedule::{
 /// How many things of each kind the world holds (quarantined ones counted apart).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct BodyCounts {
-    /// Particle entities (with [`Mass`]).
+    /// Particle entities (with [`Mass`](crate::particles::Mass)).
     pub particles: usize,
     /// Tracers.
     pub tracers: usize,
     /// Spring entities.
     pub springs: usize,
-    /// Mesh entities (with [`Nodes`]).
+    /// Mesh entities (with [`Nodes`](crate::particles::Nodes)).
     pub meshes: usize,
     /// Nodes over all meshes.
     pub mesh_nodes: usize,

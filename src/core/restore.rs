@@ -2,7 +2,7 @@
 //!
 //! Every system reads its settings and state as resources; one that is missing would fail
 //! the system's parameter check, which panics. Each plugin installs its resources through
-//! [`init`], which also remembers how to make them; at the start of every step,
+//! `init`, which also remembers how to make them; at the start of every step,
 //! [`PhysicsSystems::Restore`](crate::core::schedule::PhysicsSystems::Restore) re-creates any that were
 //! removed, at their defaults, and writes one [`ResourceRestored`] message for each. A
 //! removed state resource ([`crate::collision::Contacts`], the broad phase) starts afresh: contacts are

@@ -6,7 +6,7 @@
 //! two passes (each with a gather and a scatter), the position half, renormalisation. For a
 //! world of rigid bodies under constant forces that round trip is most of the step's cost
 //! outside the solver itself. The collision plugin therefore registers a
-//! [`WholeStepRunner`]: a function that loads the bodies once, runs every substep with the
+//! `WholeStepRunner`: a function that loads the bodies once, runs every substep with the
 //! very same arithmetic in the same order, and stores them once. Results are bit-identical
 //! with the schedule's (`tests/it/integrators/whole_step.rs` compares the two paths after every step, and
 //! lists every substep system with how this path treats it).
@@ -15,7 +15,7 @@
 //! - [`FusedSubsteps`] is on (the default);
 //! - the substep schedule holds only hooke's own systems ([`crate::core::schedule`] counts them):
 //!   a game system in the substeps (a force written every substep) keeps the schedule;
-//! - no entity holds a component registered with [`block_on`]. Each effect whose substep
+//! - no entity holds a component registered with `block_on`. Each effect whose substep
 //!   systems the runner does not replicate (springs, damping, meshes, tracers, forces at
 //!   points, impulses, integrator overrides) registers the components its systems act on.
 //!

@@ -286,7 +286,7 @@ impl Snapshot {
     /// Captures the physics state of `world`, between steps.
     ///
     /// # Errors
-    /// [`SnapshotError::Unsupported`] for a [`VelocityField::Custom`] (a closure).
+    /// [`SnapshotError::Unsupported`] for a [`VelocityField::Custom`](crate::particles::VelocityField::Custom) (a closure).
     pub fn capture(world: &World) -> Result<Self, SnapshotError> {
         let ids = Columns::component_ids(world);
         // Storage order: table by table, row by row, as a query walks them.

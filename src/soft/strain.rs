@@ -1,7 +1,7 @@
 //! The material math of soft bodies, as pure functions of the deformation gradient F.
 //!
 //! For each [`StrainModel`]: the energy density Ψ(F) (J/m³), the first Piola–Kirchhoff stress
-//! P = ∂Ψ/∂F (Pa), and its differential dP[dF] = (∂P/∂F) : dF (Pa), which the implicit
+//! P = ∂Ψ/∂F (Pa), and its differential dP\[dF\] = (∂P/∂F) : dF (Pa), which the implicit
 //! solver needs. The strains and the linear stress σ = λ tr(ε) I + 2 μ ε are the lecture's;
 //! see the [module docs](super) for the equations of each model and when to use it.
 
@@ -258,13 +258,13 @@ impl StrainModel {
         self.stress(f, lame).piola
     }
 
-    /// dP[dF] = (∂P/∂F) : dF (Pa), the stress differential along dF.
+    /// dP\[dF\] = (∂P/∂F) : dF (Pa), the stress differential along dF.
     #[must_use]
     pub fn differential(self, f: Mat3, df: Mat3, lame: Lame) -> Mat3 {
         Prepared::new(self, f, lame).differential(df, lame)
     }
 
-    /// dP[Eᵢⱼ] for the nine unit directions Eᵢⱼ (column-major order: entry k is the
+    /// dP\[Eᵢⱼ\] for the nine unit directions Eᵢⱼ (column-major order: entry k is the
     /// derivative along the k-th entry of F's column-major array): the columns of the
     /// 9 × 9 matrix ∂P/∂F. The work shared between directions (a polar decomposition, a
     /// cofactor) is done once.

@@ -243,16 +243,16 @@ fn orphaned(
     }
 }
 
-/// Explicit meshes only: an [`crate::integrator::ImplicitEuler`] mesh's springs act inside its solve.
+type ExplicitNetwork = (
+    Without<Quarantined>,
+    Without<crate::integrator::ImplicitEuler>,
+);
+
+/// Explicit meshes only: an [`crate::integrator::ImplicitEuler`] mesh's springs act inside its
+/// solve.
 fn apply_network_forces(
     mut commands: Commands,
-    mut meshes: Query<
-        (Entity, &mut Nodes, &SpringNetwork),
-        (
-            Without<Quarantined>,
-            Without<crate::integrator::ImplicitEuler>,
-        ),
-    >,
+    mut meshes: Query<(Entity, &mut Nodes, &SpringNetwork), ExplicitNetwork>,
 ) {
     for (e, mut nodes, network) in &mut meshes {
         if !network.accumulate(nodes.bypass_change_detection()) {

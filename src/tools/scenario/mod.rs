@@ -38,7 +38,7 @@
 //! - **Hash.** [`Report::hash`] is [`crate::snapshot::Snapshot::digest`] of the final state;
 //!   `hash: "…"` in the file pins it, and a different result fails the run.
 //!
-//! The vocabulary is in [`format`]; the command-line runner is `cargo run --release
+//! The vocabulary is in [`mod@format`]; the command-line runner is `cargo run --release
 //! --features cli --bin hooke -- run scenarios/*.ron`.
 
 mod check;

@@ -1,3 +1,3 @@
 //! Cloth: builders, wind, strain limiting, collisions and the implicit path.
 
-mod cloth;
+mod meshes_and_drapes;

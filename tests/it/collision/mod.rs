@@ -1,8 +1,8 @@
 //! Contacts and queries: solver behaviour on stacks and impacts, tunnelling, recycling, the broad phase and spatial queries.
 
 mod broad_phase_hears_pose_changes;
-mod collision;
 mod compound_part_frames;
+mod contacts_against_closed_forms;
 mod contacts_end_with_the_last_collider;
 mod deep_overlap_recovery;
 mod fast_spin_stays_above_ground;

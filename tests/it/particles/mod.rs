@@ -1,3 +1,3 @@
 //! Particles and tracers: free fall, projectiles, damping and velocity fields against closed forms.
 
-mod particles;
+mod free_fall_and_fields;

@@ -2,4 +2,4 @@
 
 mod mass;
 mod rapier_crosscheck;
-mod rigid;
+mod torque_free_motion;

@@ -1,4 +1,4 @@
 //! The one order: schedules, plugins, diagnostics and the test helpers.
 
-mod schedule;
+mod order_and_plugins;
 mod testing_helpers;

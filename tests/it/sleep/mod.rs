@@ -1,5 +1,5 @@
 //! Sleeping islands: falling asleep, waking on contact and on structural change.
 
-mod sleep;
+mod islands;
 mod structural_change_wakes;
 mod wake_in_the_step_of_impact;

@@ -1,4 +1,4 @@
 //! Snapshots and determinism goldens: a restored world continues bit for bit.
 
+mod continue_bit_identically;
 mod determinism_goldens;
-mod snapshot;

@@ -2,7 +2,7 @@
 
 mod chain;
 mod default_builders_stable;
+mod force_law_and_chains;
 mod implicit_entities;
 mod implicit_meshes;
-mod springs;
 mod stiff_springs_warned_and_caught;
