@@ -5,19 +5,27 @@
 
 mod quick_start {
     // README-BEGIN
+    use std::time::Duration;
+
+    use bevy_app::ScheduleRunnerPlugin;
     use bevy_app::prelude::*;
     use bevy_ecs::prelude::*;
+    use bevy_time::prelude::*;
     use bevy_transform::prelude::*;
     use hooke::prelude::*;
 
-    fn main() {
+    fn main() -> AppExit {
         App::new()
-            // With the umbrella crate: `DefaultPlugins` (or `MinimalPlugins`) instead of these two.
-            .add_plugins((bevy_time::TimePlugin, TransformPlugin))
+            // With the `bevy` crate: `DefaultPlugins` (a window) or `MinimalPlugins` instead.
+            .add_plugins((
+                ScheduleRunnerPlugin::run_loop(Duration::from_secs_f64(1.0 / 60.0)),
+                bevy_time::TimePlugin,
+                TransformPlugin,
+            ))
             .add_plugins(PhysicsPlugins) // every effect, one clock, Transform sync, interpolation
             .add_systems(Startup, setup)
-            .add_systems(Update, on_landing)
-            .run();
+            .add_systems(Update, (on_landing, stop_after_three_seconds))
+            .run()
     }
 
     fn setup(mut commands: Commands) -> Result {
@@ -55,6 +63,12 @@ mod quick_start {
             println!("{:?} touches {:?}", contact.a, contact.b);
         }
     }
+
+    fn stop_after_three_seconds(time: Res<Time>, mut exit: MessageWriter<AppExit>) {
+        if time.elapsed_secs() > 3.0 {
+            exit.write(AppExit::Success);
+        }
+    }
     // README-END
 
     #[test]
@@ -63,7 +77,7 @@ mod quick_start {
         let begin = me.find("// README-BEGIN\n").unwrap() + "// README-BEGIN\n".len();
         let end = me.find("    // README-END").unwrap();
         let readme = include_str!("../../../README.md");
-        // The test's copy is indented one level by rustfmt; compare without whitespace.
+        // The test's copy is indented one level; compare word for word, whitespace aside.
         let squash = |s: &str| s.split_whitespace().collect::<String>();
         assert!(
             squash(readme).contains(&squash(&me[begin..end])),
@@ -72,9 +86,11 @@ mod quick_start {
     }
 
     #[test]
-    fn the_readme_app_runs() {
-        // `App::run` with no runner plugin runs one update and returns.
-        main();
+    fn the_readme_app_runs_three_seconds_and_exits() {
+        let start = std::time::Instant::now();
+        assert_eq!(main(), AppExit::Success);
+        let took = start.elapsed().as_secs_f64();
+        assert!(took > 2.9, "the runner loops until the app exits: {took} s");
     }
 
     #[test]
