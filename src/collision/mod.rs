@@ -5,7 +5,7 @@
 //! 1. bounding boxes of moving colliders, grown by the distance they can travel in the step
 //!    (the *speculative margin*, so fast bodies find what they would hit);
 //! 2. broad phase: incremental sort-and-sweep over moving boxes and a tree of fixed ones
-//!    (see the `broad` module). Fixed colliders cost nothing per step: they are meant to stay
+//!    (see the `broad_phase` module). Fixed colliders cost nothing per step: they are meant to stay
 //!    put, and the broad phase hears of a change through component hooks, so move a static
 //!    collider by inserting a new `Position` or `Rotation` (or make it kinematic);
 //! 3. narrow phase: parry's persistent contact manifolds per pair, which carry each contact's
@@ -16,8 +16,8 @@
 //!    manifold's normal and lever arms are taken when its points are found and held in the
 //!    world frame, riding with each body's centre of mass, until its points are found again
 //!    more than 2 cm away (the separation is still measured at the turned points): arms that
-//!    turned with a leaning box swung its support against the lean, and a column of 20 boxes
-//!    toppled in 5 s.
+//!    turned with a leaning box would swing its support against the lean and topple tall
+//!    columns.
 //!
 //! **Solver, every substep** (Box2D v3's soft step): after the velocities are integrated,
 //! the contacts are warm-started and solved with a soft position bias (spring of

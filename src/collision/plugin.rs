@@ -19,7 +19,7 @@ pub struct CollisionPlugin;
 impl WorldPlugin for CollisionPlugin {
     fn build(&self, world: &mut World) {
         crate::core::restore::init::<ContactSettings>(world);
-        crate::collision::solver::fused::install(world);
+        crate::collision::solver::whole_step::install(world);
         add_own_systems(
             world,
             PhysicsSchedule,

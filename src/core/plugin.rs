@@ -17,7 +17,7 @@ use super::restore::{self, InvalidSetting, ResourceRestored};
 use super::schedule::SubstepSchedule;
 use super::schedule::{self, PhysicsSchedule, PhysicsSystems};
 use super::time::{FrameReport, PhysicsTime, SubstepTime};
-use super::whole_step::FusedSubsteps;
+use super::whole_step::WholeStep;
 use super::{diagnostics, error::Result};
 
 /// A piece of physics that installs itself into a `World`: resources and systems.
@@ -57,7 +57,7 @@ impl WorldPlugin for PhysicsCorePlugin {
             restore::restore_resources.in_set(PhysicsSystems::Restore),
         );
         restore::init::<SubstepTime>(world);
-        restore::init::<FusedSubsteps>(world);
+        restore::init::<WholeStep>(world);
         add_message::<BodyQuarantined>(world);
         restore::init::<DivergenceGuard>(world);
         schedule::add_own_systems(

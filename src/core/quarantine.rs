@@ -104,8 +104,9 @@ pub struct DivergenceGuard {
     /// stretched to 101 times its rest length). Zero-length springs are not checked.
     pub max_spring_strain: f32,
     /// Distance from the origin along any axis beyond any game world's (m; default 1e6,
-    /// [`crate::collision::Collider::MAX_EXTENT`]: f32 resolves positions there to 6 cm). The fuzzer found
-    /// a body flung to 2e8 m within one step at a speed the step's last pass had undone.
+    /// [`crate::collision::Collider::MAX_EXTENT`]: f32 resolves positions there to 6 cm). Checked
+    /// on positions as well as speeds: a body can be flung far within one step at a speed the
+    /// step's last pass has already undone.
     #[serde(default = "far")]
     pub max_distance: f32,
     /// Angular speed beyond any body's in a game (rad/s; default 1e5, 16,000 turns a second:

@@ -12,7 +12,7 @@
 //! lists every substep system with how this path treats it).
 //!
 //! The runner is tried only when the schedule would do nothing it does not replicate:
-//! - [`FusedSubsteps`] is on (the default);
+//! - [`WholeStep`] is on (the default);
 //! - the substep schedule holds only hooke's own systems ([`crate::core::schedule`] counts them):
 //!   a game system in the substeps (a force written every substep) keeps the schedule;
 //! - no entity holds a component registered with `block_on`. Each effect whose substep
@@ -32,9 +32,9 @@ use crate::core::schedule::{OwnSubstepSystems, SubstepSchedule};
 /// [`crate::core::schedule::SubstepSchedule`]; results are the same bit for bit, so this is only for
 /// comparisons and for debugging a game system placed in the substeps.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq)]
-pub struct FusedSubsteps(pub bool);
+pub struct WholeStep(pub bool);
 
-impl Default for FusedSubsteps {
+impl Default for WholeStep {
     fn default() -> Self {
         Self(true)
     }
@@ -75,7 +75,7 @@ fn blocked(world: &World) -> bool {
 /// when the schedule must run them.
 pub(crate) fn try_whole_step(world: &mut World) -> bool {
     let runner = world.get_resource::<WholeStepRunner>().copied();
-    let on = world.get_resource::<FusedSubsteps>().is_some_and(|f| f.0);
+    let on = world.get_resource::<WholeStep>().is_some_and(|f| f.0);
     let (Some(runner), true) = (runner, on) else {
         if let Some(mut d) =
             world.get_resource_mut::<crate::core::diagnostics::PhysicsDiagnostics>()

@@ -226,7 +226,7 @@ fn position_phase(method: Integrator, x: &mut Vec3A, v: Vec3A, h: f32) {
     }
 }
 
-type BodyState<'a> = (
+type IntegratedBody<'a> = (
     &'a mut Position,
     &'a mut LinearVelocity,
     &'a Force,
@@ -241,8 +241,8 @@ fn integrate_velocities(
     constraints: Res<ConstraintsActive>,
     time: Res<SubstepTime>,
     mut set: ParamSet<(
-        Query<BodyState, (Without<IntegratorOverride>, Simulated)>,
-        Query<(BodyState, &IntegratorOverride), Simulated>,
+        Query<IntegratedBody, (Without<IntegratorOverride>, Simulated)>,
+        Query<(IntegratedBody, &IntegratorOverride), Simulated>,
         Suspects,
     )>,
     mut meshes: Query<(&mut Nodes, Option<&IntegratorOverride>), super::ExplicitMesh>,

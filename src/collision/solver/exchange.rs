@@ -36,7 +36,7 @@ pub(crate) const ROUNDING_TURN: f32 = 1e-12;
 
 /// The squared quaternion distance within which a body of bounding radius `reach` (m)
 /// reuses its ΔR: a turn by θ moves a point r out by θ r, and θ ≈ 2 |Δq|. At least
-/// [`ROUNDING_TURN`] (the limit before the tolerance), which sets it past a reach of
+/// [`ROUNDING_TURN`] (the floor of f32 rounding), which sets it past a reach of
 /// 0.87 m: there the lag is up to 2e-6 rad times the reach.
 #[must_use]
 pub(crate) fn same_turn(reach: f32) -> f32 {
@@ -441,7 +441,7 @@ mod tests {
 
     /// A turn just within `same_turn(reach)` moves a point `reach` out from the centre by
     /// at most `ANCHOR_LAG`, about any axis; twice that turn is past it. Past a reach of
-    /// 0.87 m the rounding floor (1e-12) sets the limit, as before the tolerance.
+    /// 0.87 m the rounding floor (1e-12) sets the limit.
     #[test]
     fn a_reused_turn_lags_an_anchor_by_at_most_the_tolerance() {
         for reach in [0.05f32, 0.5, 0.866] {

@@ -81,12 +81,9 @@ impl ContactSolver {
 /// (J) left: all of it if it adds no more than the budget (or takes energy out), else the
 /// share of it that spends what is left, none once the budget is spent.
 ///
-/// Why: the budget goes negative when the step's impulses added energy (push-out). The
-/// share used to be `budget / cost` whenever the cost exceeded the budget, and with both
-/// negative that is more than one: an impulse that took a little energy out was scaled up
-/// to one that added a lot. A struck row of three boxes (e = 0.5, μ = 0.5) left at 280 m/s
-/// when the solver took a face's corners in another order (2,259 N·s at one corner, from a
-/// wanted 35 N·s scaled by 64).
+/// Why the budget is clamped at zero first: it goes negative when the step's impulses added
+/// energy (push-out), and `budget / cost` with both negative is more than one, which would
+/// scale an impulse that takes a little energy out up to one that adds a lot.
 #[must_use]
 pub(super) fn budget_share(cost: f32, budget: f32) -> f32 {
     let left = budget.max(0.0);

@@ -44,7 +44,11 @@ fn every_image_the_docs_show_exists() {
         }
     }
     assert!(shown >= 3, "the README and docs show pictures: {shown}");
-    assert!(missing.is_empty(), "missing pictures:\n{}", missing.join("\n"));
+    assert!(
+        missing.is_empty(),
+        "missing pictures:\n{}",
+        missing.join("\n")
+    );
 }
 
 #[test]

@@ -8,7 +8,7 @@ use glam::{Quat, Vec3};
 use hooke::core::diagnostics::PhysicsDiagnostics;
 use hooke::core::quarantine::{BodyQuarantined, QuarantineReason, Quarantined};
 use hooke::core::schedule::{ForceSystems, add_force_systems};
-use hooke::core::whole_step::FusedSubsteps;
+use hooke::core::whole_step::WholeStep;
 use hooke::prelude::*;
 use hooke::rigid::{AngularMomentum, ExternalTorque, Torque};
 use hooke::tools::scenes;
@@ -51,7 +51,7 @@ fn pair(build: impl Fn(&mut World)) -> [World; 2] {
     [true, false].map(|on| {
         let mut world = World::new();
         world.add_physics(PhysicsPlugins);
-        world.insert_resource(FusedSubsteps(on));
+        world.insert_resource(WholeStep(on));
         build(&mut world);
         world
     })
