@@ -164,8 +164,8 @@ pub mod tools;
 /// parry, re-exported so custom shapes ([`Collider::new`](crate::collision::Collider::new)) need no second dependency.
 pub use parry3d;
 
-pub use core::error::{Error, Result};
-pub use plugins::{PhysicsPlugins, PhysicsWorldExt};
+pub use crate::core::error::{Error, Result};
+pub use crate::plugins::{PhysicsPlugins, PhysicsWorldExt};
 
 /// Everything a game needs in scope.
 pub mod prelude {

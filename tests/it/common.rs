@@ -41,10 +41,23 @@ pub fn gravity_world(substeps: u32) -> World {
     .unwrap()
 }
 
+/// A world with every plugin at its defaults, as a game starts.
+pub fn default_world() -> World {
+    let mut w = World::new();
+    w.add_physics(PhysicsPlugins);
+    w
+}
+
+/// A world of step `dt`, `substeps`, symplectic Euler and gravity `g`, with sleeping off (so
+/// that nothing the test watches stops moving on its own).
+pub fn awake_world(dt: f32, substeps: u32, g: Vec3) -> World {
+    let mut w = scenes::world_with(dt, substeps, Integrator::SymplecticEuler, g).unwrap();
+    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
+    w
+}
+
 /// A contact test's world: [`gravity_world`] with sleeping off (so that nothing the test
 /// watches stops moving on its own).
 pub fn contact_world(substeps: u32) -> World {
-    let mut w = gravity_world(substeps);
-    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
-    w
+    awake_world(1.0 / 60.0, substeps, Vec3::new(0.0, -9.81, 0.0))
 }

@@ -2,6 +2,7 @@
 //! a drape over a sphere, a flag in wind, strain limiting, and a ball caught by a cloth
 //! (two-way node contacts), at 60 Hz through the public API.
 
+use crate::common;
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 use hooke::Error;
@@ -11,12 +12,9 @@ use hooke::cloth::ClothMaterial;
 use hooke::core::quarantine::Quarantined;
 use hooke::integrator::ImplicitEuler;
 use hooke::prelude::*;
-use hooke::tools::scenes;
 
 fn world(substeps: u32, g: Vec3) -> World {
-    let mut w = scenes::world_with(1.0 / 60.0, substeps, Integrator::SymplecticEuler, g).unwrap();
-    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
-    w
+    common::awake_world(1.0 / 60.0, substeps, g)
 }
 
 const G: Vec3 = Vec3::new(0.0, -9.81, 0.0);

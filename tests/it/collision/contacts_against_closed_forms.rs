@@ -21,15 +21,7 @@ const G: f32 = 9.81;
 /// Sleeping off: a sleeping body cannot drift, so with it on a stability test could pass
 /// without measuring anything.
 fn world(substeps: u32) -> World {
-    let mut w = scenes::world_with(
-        1.0 / 60.0,
-        substeps,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -G, 0.0),
-    )
-    .unwrap();
-    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
-    w
+    crate::common::awake_world(1.0 / 60.0, substeps, Vec3::new(0.0, -G, 0.0))
 }
 
 fn pos(w: &World, e: Entity) -> Vec3 {

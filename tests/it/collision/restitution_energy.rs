@@ -7,15 +7,14 @@
 //! of what the normal impulses took out). These tests hold every step of a family of scenes to
 //! "kinetic energy after ≤ before (plus gravity's work)", and check Newton's cradle.
 
+use crate::common;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::prelude::*;
 use hooke::tools::scenes;
 
 fn world(g: Vec3) -> World {
-    let mut w = scenes::world_with(1.0 / 60.0, 4, Integrator::SymplecticEuler, g).unwrap();
-    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
-    w
+    common::awake_world(1.0 / 60.0, 4, g)
 }
 
 fn kinetic(w: &World) -> f64 {

@@ -1,6 +1,7 @@
 //! Issue 15: bad input reproduced on the previous main, each now a typed error, a
 //! quarantine or a correction, never a panic or a silent NaN.
 
+use crate::common;
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemState;
@@ -16,13 +17,7 @@ use hooke::sleep::SleepSettings;
 use hooke::tools::scenes;
 
 fn world() -> World {
-    scenes::world_with(
-        1.0 / 60.0,
-        4,
-        Integrator::SymplecticEuler,
-        Vec3::new(0.0, -9.81, 0.0),
-    )
-    .unwrap()
+    common::gravity_world(4)
 }
 
 fn messages<M: Message + Clone>(w: &World) -> Vec<M> {

@@ -2,6 +2,7 @@
 //! pre-tension; springs read out their length, strain and tension (`Spring::reading`,
 //! `SpringNetwork::reading`), against closed forms.
 
+use crate::common;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::particles::LinearDamping;
@@ -10,9 +11,7 @@ use hooke::springs::ChainBuilder;
 use hooke::springs::Spring;
 
 fn world() -> World {
-    let mut w = World::new();
-    w.add_physics(PhysicsPlugins);
-    w
+    common::default_world()
 }
 
 #[test]

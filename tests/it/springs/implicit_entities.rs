@@ -80,11 +80,7 @@ fn stiff_rope() -> ChainBuilder {
         .stiffness(weight / (1e-3 / 19.0))
 }
 
-fn default_world() -> World {
-    let mut w = World::new();
-    w.add_physics(PhysicsPlugins);
-    w
-}
+use common::default_world;
 
 #[test]
 fn a_stiff_rope_just_works_at_the_defaults_the_policy_switches_it_to_backward_euler() {

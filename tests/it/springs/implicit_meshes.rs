@@ -4,6 +4,7 @@
 //! one substep, each spring carrying the weight below it; a stiff cloth stable where
 //! symplectic Euler needs many substeps; momentum kept.
 
+use crate::common;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::cloth::ClothBuilder;
@@ -11,13 +12,8 @@ use hooke::core::quarantine::Quarantined;
 use hooke::integrator::ImplicitEuler;
 use hooke::integrator::ImplicitState;
 use hooke::prelude::*;
-use hooke::tools::scenes;
 
-fn world(dt: f32, substeps: u32, g: Vec3) -> World {
-    let mut w = scenes::world_with(dt, substeps, Integrator::SymplecticEuler, g).unwrap();
-    w.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
-    w
-}
+use common::awake_world as world;
 
 /// m = 1 kg on a zero-length spring k = 4π² to a pinned node: period 1 s, x₀ = 1.
 fn oscillator(w: &mut World) -> Entity {
