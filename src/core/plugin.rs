@@ -161,14 +161,14 @@ fn run_substeps(world: &mut World) {
     }
 }
 
+/// Swaps the buffers of every registered message type (no allocation: the registry is
+/// taken out of the world while its functions run).
 fn rotate_messages(world: &mut World) {
-    let rotations = world
-        .get_resource::<Installed>()
-        .map(|i| i.rotations.clone())
-        .unwrap_or_default();
-    for rotate in rotations {
-        rotate(world);
-    }
+    world.try_resource_scope::<Installed, _>(|world, installed| {
+        for rotate in &installed.rotations {
+            rotate(world);
+        }
+    });
 }
 
 /// Runs the physics schedule once and records its wall time.
