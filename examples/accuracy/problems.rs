@@ -6,13 +6,13 @@ use hooke::collision::Collider;
 use hooke::collision::Friction;
 use hooke::collision::Restitution;
 use hooke::core::schedule::{ForceSystems, add_force_systems};
+use hooke::integrator::StabilityPolicy;
 use hooke::prelude::*;
 use hooke::rigid::Inertia;
 use hooke::rigid::MassProperties;
 use hooke::rigid::OrientationUpdate;
 use hooke::rigid::RigidBodyBundle;
 use hooke::rigid::Rotation;
-use hooke::springs::StabilityPolicy;
 use hooke::tools::accuracy::{
     Measurement, Reference, Setting, Sweep, SweepReport, sweep, timed_run,
 };

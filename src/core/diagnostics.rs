@@ -84,8 +84,20 @@ pub struct PhysicsDiagnostics {
     /// The smallest explicit stability limit of the spring systems (s; 0 until the spring
     /// plugin has looked, infinite without springs). See [`crate::springs::stability`].
     pub spring_critical_step: f32,
-    /// Spring systems warned to be past their stability limit (each once).
+    /// The smallest explicit stability limit of the soft bodies (s; infinite without any).
+    /// See [`crate::soft`].
+    pub soft_critical_step: f32,
+    /// Systems (spring meshes, the entity springs, soft bodies) warned to be past their
+    /// stability limit (each once).
     pub stability_warnings: u64,
+    /// Of those, the ones [`crate::integrator::StabilityPolicy`] switched to an implicit
+    /// scheme (since the world started).
+    pub rescued: u64,
+    /// The energy the implicit schemes take from the motion beyond what the model's own
+    /// damping takes, summed over every implicitly solved system (W = J/s, averaged over about
+    /// a second): the price of the rescue, in the motion it removes. Zero when nothing is
+    /// solved implicitly.
+    pub numerical_damping: f64,
 }
 
 impl PhysicsDiagnostics {

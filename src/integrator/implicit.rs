@@ -102,6 +102,12 @@ pub struct ImplicitReport {
 /// gradients stall at a relative residual of about 1e-2.
 pub(crate) struct Scratch<E: ImplicitElements> {
     x0: Vec<Vec3A>,
+    /// Each node's displacement from `x0` in f64 (the iterate is x0 + disp rounded), so that
+    /// the velocity it gives keeps resolution below an f32 position's ulp over h.
+    disp: Vec<DVec3>,
+    /// The velocity's origin x̂ − x0: zero for backward Euler, ⅓ of the last increment for
+    /// BDF2.
+    base: Vec<DVec3>,
     y: Vec<Vec3A>,
     trial: Vec<Vec3A>,
     elastic: Vec<Vec3A>,
@@ -123,6 +129,8 @@ pub(crate) struct Scratch<E: ImplicitElements> {
     free: Vec<bool>,
     /// Per node, the normal of a contact holding it (zero for none).
     filter: Vec<DVec3>,
+    /// Per node, whether a contact plane holds it at the end of the solve.
+    contact: Vec<bool>,
     /// Whether any element is indefinite this iteration, which ones, and whether `hess`
     /// holds this iteration's projections yet.
     indefinite: bool,
@@ -139,6 +147,8 @@ impl<E: ImplicitElements> Default for Scratch<E> {
     fn default() -> Self {
         Self {
             x0: Vec::new(),
+            disp: Vec::new(),
+            base: Vec::new(),
             y: Vec::new(),
             trial: Vec::new(),
             elastic: Vec::new(),
@@ -156,6 +166,7 @@ impl<E: ImplicitElements> Default for Scratch<E> {
             hess0: Vec::new(),
             free: Vec::new(),
             filter: Vec::new(),
+            contact: Vec::new(),
             indefinite: false,
             negative: Vec::new(),
             projected: false,
@@ -231,6 +242,7 @@ fn refresh_factor<'a, E: ImplicitElements>(
     let renew = state.refactor || !state.factor.as_ref()?.is_factored();
     let factor = state.factor.as_mut()?;
     if renew {
+        factor.step = hd as f32;
         state.refactor = false;
         state.excess = 0.0;
         let mass_term = |m: f32| f64::from(m) * (1.0 / (hd * hd) + alpha / hd);
@@ -282,15 +294,16 @@ fn potential_rest<E: ImplicitElements>(
             continue;
         }
         let m = f64::from(n.mass[i]);
-        let (xi, yi, x0) = (d3(x[i]), d3(s.y[i]), d3(s.x0[i]));
+        let (xi, yi) = (d3(x[i]), d3(s.y[i]));
+        let moved = xi - d3(s.x0[i]) - s.base[i];
         e += 0.5 * m * inv_h2 * (xi - yi).length_squared()
-            + 0.5 * alpha * m / h * (xi - x0).length_squared()
+            + 0.5 * alpha * m / h * moved.length_squared()
             - d3(n.f[i]).dot(xi);
     }
     if !s.hess0.is_empty() {
-        // ½ (x − x₀)ᵀ D (x − x₀) / h
+        // ½ (x − x̂)ᵀ D (x − x̂) / h
         for i in 0..x.len() {
-            s.d[i] = d3(x[i]) - d3(s.x0[i]);
+            s.d[i] = d3(x[i]) - d3(s.x0[i]) - s.base[i];
             s.kd[i] = DVec3::ZERO;
         }
         let (d, mut kd) = (std::mem::take(&mut s.d), std::mem::take(&mut s.kd));
@@ -328,14 +341,22 @@ pub(crate) fn step<E: ImplicitElements>(
     s: &mut Scratch<E>,
 ) -> Option<ImplicitReport> {
     let len = n.x.len();
-    prepare_factor(body, settings, state, len, h);
-    let (alpha, hd) = (body.mass_damping(), f64::from(h));
+    // BDF2 with a history from the same step: the backward-Euler potential about
+    // x̂ = (4x₀ − x₋₁)/3 with velocity v̂ = (4v₀ − v₋₁)/3 and step ⅔h.
+    let bdf2 = settings.scheme == super::ImplicitScheme::Bdf2
+        && state.history_h == h
+        && state.history.len() == len;
+    let h_solve = if bdf2 { h * (2.0 / 3.0) } else { h };
+    prepare_factor(body, settings, state, len, h_solve);
+    let (alpha, hd) = (body.mass_damping(), f64::from(h_solve));
     let count = body.count();
     for buf in [&mut s.x0, &mut s.y, &mut s.trial, &mut s.elastic] {
         buf.clear();
         buf.resize(len, Vec3A::ZERO);
     }
     for buf in [
+        &mut s.disp,
+        &mut s.base,
         &mut s.g,
         &mut s.dx,
         &mut s.r,
@@ -350,12 +371,33 @@ pub(crate) fn step<E: ImplicitElements>(
         buf.resize(len, DVec3::ZERO);
     }
     s.x0.copy_from_slice(&n.x);
+    let carried = state.remainder.len() == len;
     for i in 0..len {
-        s.y[i] = n.x[i] + h * n.v[i];
+        if n.inv_mass[i] == 0.0 {
+            // A pinned (or steered) node moves with its velocity over the whole substep.
+            s.disp[i] = f64::from(h) * d3(n.v[i]);
+            s.y[i] = at(s.x0[i], s.disp[i]);
+            continue;
+        }
+        if carried {
+            s.base[i] = state.remainder[i].as_dvec3();
+        }
+        let v = if bdf2 {
+            // The last solve's own increments, not the states: an impulse a contact or an
+            // attachment gave a node since is a jump, which the formula would extrapolate
+            // as a trend (by 4/3) and so pump energy into every contact.
+            let (dx, dv) = state.history[i];
+            s.base[i] += dx / 3.0;
+            d3(n.v[i]) + dv / 3.0
+        } else {
+            d3(n.v[i])
+        };
+        s.disp[i] = s.base[i] + hd * v;
+        s.y[i] = at(s.x0[i], s.disp[i]);
     }
     // The inertial predictor is the first iterate; pinned nodes stay there.
     // Contacts found at the end of the last substep: planes n·x ≥ d the nodes may not cross.
-    clamp_to_contacts(body.planes(), &mut s.y);
+    clamp_to_contacts(body.planes(), &mut s.y, &s.x0, &mut s.disp);
     n.x.copy_from_slice(&s.y);
     let mut free = std::mem::take(&mut s.free);
     free.clear();
@@ -396,14 +438,14 @@ pub(crate) fn step<E: ImplicitElements>(
             s.g[i] = if free[i] {
                 let m = f64::from(n.mass[i]);
                 m * inv_h2 * (d3(n.x[i]) - d3(s.y[i])) - d3(s.elastic[i]) - d3(n.f[i])
-                    + alpha * m / hd * (d3(n.x[i]) - d3(s.x0[i]))
+                    + alpha * m / hd * (d3(n.x[i]) - d3(s.x0[i]) - s.base[i])
             } else {
                 DVec3::ZERO
             };
         }
         if !s.hess0.is_empty() {
             for i in 0..len {
-                s.d[i] = d3(n.x[i]) - d3(s.x0[i]);
+                s.d[i] = d3(n.x[i]) - d3(s.x0[i]) - s.base[i];
                 s.kd[i] = DVec3::ZERO;
             }
             let (d, mut kd) = (std::mem::take(&mut s.d), std::mem::take(&mut s.kd));
@@ -436,12 +478,13 @@ pub(crate) fn step<E: ImplicitElements>(
         }
         if it == 0 {
             // The force scale of the step: the first gradient, or, for a body already at rest
-            // (where that is only rounding), its weight and momentum over h.
+            // (where that is only rounding), the forces on its nodes. Not its momentum over
+            // h: at small h that dwarfs the forces, and a tolerance on it would accept the
+            // predictor without any elastic force at all.
             let mut load = 0.0f64;
             for i in 0..len {
                 if free[i] {
-                    let momentum = f64::from(n.mass[i]) * d3(n.v[i]) / hd;
-                    load += (d3(n.f[i]).length() + momentum.length()).powi(2);
+                    load += (d3(n.f[i]).length() + d3(s.elastic[i]).length()).powi(2);
                 }
             }
             g0 = gnorm.max(load.sqrt());
@@ -531,9 +574,10 @@ pub(crate) fn step<E: ImplicitElements>(
                 .all(|(d, &f)| !f || d.abs().max_element() <= resolution);
         if last {
             for i in 0..len {
-                n.x[i] = Vec3A::from((d3(n.x[i]) + s.dx[i]).as_vec3());
+                s.disp[i] += s.dx[i];
+                n.x[i] = at(s.x0[i], s.disp[i]);
             }
-            clamp_to_contacts(body.planes(), &mut n.x);
+            clamp_to_contacts(body.planes(), &mut n.x, &s.x0, &mut s.disp);
             elastic_now = body.prepare(&n.x, &mut s.prep);
             break;
         }
@@ -546,7 +590,7 @@ pub(crate) fn step<E: ImplicitElements>(
         for _ in 0..12 {
             let mut trial = std::mem::take(&mut s.trial);
             for i in 0..len {
-                trial[i] = Vec3A::from((d3(n.x[i]) + step * s.dx[i]).as_vec3());
+                trial[i] = at(s.x0[i], s.disp[i] + step * s.dx[i]);
             }
             let elastic = body.prepare(&trial, &mut s.prep_trial);
             let e_new = elastic + potential_rest(body, n, s, &trial, hd, alpha);
@@ -561,16 +605,67 @@ pub(crate) fn step<E: ImplicitElements>(
         if !accepted {
             break;
         }
+        for i in 0..len {
+            s.disp[i] += step * s.dx[i];
+        }
         std::mem::swap(&mut s.prep, &mut s.prep_trial);
-        let moved = clamp_to_contacts(body.planes(), &mut s.trial);
+        let moved = clamp_to_contacts(body.planes(), &mut s.trial, &s.x0, &mut s.disp);
         clamped = moved;
         n.x.copy_from_slice(&s.trial);
         if moved {
             elastic_now = body.prepare(&n.x, &mut s.prep);
         }
     }
+    s.contact.clear();
+    s.contact.resize(len, false);
+    for c in body.planes() {
+        let i = c.node as usize;
+        s.contact[i] = c.normal.dot(Vec3::from(n.x[i])) <= c.offset + 1e-6;
+    }
+    // The velocity from the f64 displacement, (x₁ − x̂)/h: an f32 difference of positions
+    // would resolve only ulp(x)/h, and a small vibration would stick at its turning points.
+    if settings.scheme == super::ImplicitScheme::Bdf2 {
+        state.history.resize(len, (DVec3::ZERO, DVec3::ZERO));
+        state.history_h = h;
+    } else {
+        state.history.clear();
+        state.history_h = 0.0;
+    }
+    state.remainder.resize(len, Vec3::ZERO);
     for i in 0..len {
-        n.v[i] = (n.x[i] - s.x0[i]) / h;
+        if !free[i] {
+            state.remainder[i] = Vec3::ZERO;
+            if let Some(slot) = state.history.get_mut(i) {
+                *slot = (DVec3::ZERO, DVec3::ZERO);
+            }
+            continue;
+        }
+        let before = if carried {
+            state.remainder[i].as_dvec3()
+        } else {
+            DVec3::ZERO
+        };
+        // A node held on a contact plane takes backward Euler's velocity, (x₁ − x₀)/h: BDF2's
+        // (x₁ − x̂)/⅔h would bounce a node that arrives at the plane back at half its speed.
+        let v = if s.contact[i] {
+            (s.disp[i] - before) / f64::from(h)
+        } else {
+            (s.disp[i] - s.base[i]) / hd
+        };
+        if let Some(slot) = state.history.get_mut(i) {
+            *slot = if s.contact[i] {
+                (DVec3::ZERO, DVec3::ZERO)
+            } else {
+                (s.disp[i] - before, v - d3(n.v[i]))
+            };
+        }
+        n.v[i] = Vec3A::from(v.as_vec3());
+        let exact = d3(s.x0[i]) + s.disp[i];
+        state.remainder[i] = if free[i] {
+            (exact - d3(n.x[i])).as_vec3()
+        } else {
+            Vec3::ZERO
+        };
     }
     s.free = free;
     // Stats at the end state, whose elements the last accepted trial prepared.
@@ -687,14 +782,26 @@ fn filtered(v: DVec3, n: DVec3) -> DVec3 {
     v - v.dot(n) * n
 }
 
-/// Moves every contact node that crossed its plane back onto it; whether any moved.
-fn clamp_to_contacts(contacts: &[ContactPlane], x: &mut [Vec3A]) -> bool {
+/// x₀ + d, rounded to f32.
+fn at(x0: Vec3A, d: DVec3) -> Vec3A {
+    Vec3A::from((d3(x0) + d).as_vec3())
+}
+
+/// Moves every contact node that crossed its plane back onto it (and its displacement from
+/// `x0` with it); whether any moved.
+fn clamp_to_contacts(
+    contacts: &[ContactPlane],
+    x: &mut [Vec3A],
+    x0: &[Vec3A],
+    disp: &mut [DVec3],
+) -> bool {
     let mut moved = false;
     for c in contacts {
         let i = c.node as usize;
         let gap = c.normal.dot(Vec3::from(x[i])) - c.offset;
         if gap < 0.0 {
             x[i] -= Vec3A::from(gap * c.normal);
+            disp[i] = d3(x[i]) - d3(x0[i]);
             moved = true;
         }
     }

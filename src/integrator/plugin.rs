@@ -46,6 +46,8 @@ impl WorldPlugin for IntegratorPlugin {
     fn build(&self, world: &mut World) {
         crate::core::restore::init::<Integrator>(world);
         crate::core::restore::init::<ConstraintsActive>(world);
+        crate::core::restore::init::<super::StabilityPolicy>(world);
+        crate::core::plugin::add_message::<super::StabilityWarning>(world);
         // The whole-step path integrates rigid bodies only, with constant forces.
         crate::core::whole_step::block_on::<ExternalImpulse>(world);
         crate::core::whole_step::block_on::<ExternalImpulseAtPoint>(world);

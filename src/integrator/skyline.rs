@@ -104,6 +104,9 @@ pub(crate) struct SkylineCholesky {
     /// Multiply-adds of one factorisation (Σ row length² / 2) and of one solve (2 × entries).
     factor_cost: f64,
     solve_cost: f64,
+    /// The step h (s) of the system matrix M/h² + K + D/h this factors (0 before the first).
+    #[serde(default)]
+    pub(crate) step: f32,
 }
 
 impl SkylineCholesky {
@@ -150,6 +153,7 @@ impl SkylineCholesky {
             generation: 0,
             factor_cost,
             solve_cost: 2.0 * entries as f64,
+            step: 0.0,
         })
     }
 

@@ -111,6 +111,7 @@ use crate::rigid::RigidBody;
 use crate::rigid::Rotation;
 use crate::rigid::SkipRenormalization;
 use crate::rigid::Torque;
+use crate::soft::SoftStability;
 use crate::soft::{NodeAttachments, NodeTargets, SoftBody};
 use crate::springs::Spring;
 use crate::springs::SpringNetwork;
@@ -145,6 +146,7 @@ plain!(
     VelocityField,
     SpringNetwork,
     SpringStability,
+    SoftStability,
     Collider,
     CollisionLayers,
     Sensor,
@@ -382,6 +384,7 @@ columns!(
     spring: Spring,
     spring_network: SpringNetwork,
     spring_stability: SpringStability,
+    soft_stability: SoftStability,
     rigid_body: RigidBody,
     rotation: Rotation,
     angular_velocity: AngularVelocity,

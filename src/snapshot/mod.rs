@@ -74,13 +74,13 @@ use crate::core::time::PhysicsTime;
 use crate::core::time::SubstepTime;
 use crate::integrator::ConstraintsActive;
 use crate::integrator::Integrator;
+use crate::integrator::StabilityPolicy;
 use crate::particles::Advection;
 use crate::particles::Gravity;
 use crate::rigid::OrientationUpdate;
 use crate::rigid::Renormalization;
 use crate::sleep::SleepSettings;
 use crate::springs::EntitySpringStability;
-use crate::springs::StabilityPolicy;
 use columns::Columns;
 
 /// The version [`Snapshot::to_bytes`] writes and [`Snapshot::from_bytes`] reads. It changes

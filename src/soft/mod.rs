@@ -34,6 +34,7 @@ mod implicit;
 mod io;
 pub mod mesh;
 mod plugin;
+pub mod stability;
 pub mod strain;
 mod targets;
 
@@ -41,6 +42,7 @@ pub use crate::integrator::ImplicitReport;
 pub use attach::{MAX_ATTACHED_NODES, NodeAttachments};
 pub use mesh::{CellSplit, TetMesh};
 pub use plugin::SoftBodyPlugin;
+pub use stability::SoftStability;
 pub use strain::{StrainModel, Stress};
 pub use targets::NodeTargets;
 
@@ -161,7 +163,7 @@ pub struct SoftBodyStats {
 /// fields, every integrator and the quarantine act on its nodes as on any mesh. Spawn both
 /// with [`SoftBody::build`].
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, PartialEq)]
-#[require(Nodes)]
+#[require(Nodes, SoftStability)]
 pub struct SoftBody {
     tets: Vec<[u32; 4]>,
     dm_inv: Vec<Mat3>,

@@ -61,6 +61,7 @@ impl WorldPlugin for SoftBodyPlugin {
                 super::targets::drive_node_targets.run_if(any_with_component::<super::NodeTargets>),
                 super::attach::anchor_attachments
                     .run_if(any_with_component::<super::NodeAttachments>),
+                super::stability::check_soft_stability.run_if(any_with_component::<SoftBody>),
             )
                 .chain()
                 .in_set(crate::core::schedule::PrepareSystems::Inputs),
@@ -112,6 +113,10 @@ fn solve_implicit(
     mut scratch: Local<crate::integrator::implicit::Scratch<SoftBody>>,
 ) {
     for (e, mut nodes, mut body, settings, mut state) in &mut bodies {
+        if nodes.is_changed() {
+            // Moved from outside the step (spawned, teleported): no history to extrapolate.
+            state.bypass_change_detection().history_h = 0.0;
+        }
         let body = body.bypass_change_detection();
         match crate::integrator::implicit::step(
             body,

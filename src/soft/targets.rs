@@ -106,7 +106,11 @@ pub(crate) fn drive_node_targets(
                 let _ = nodes.pin(i);
             }
             let x = nodes.positions()[i];
-            let _ = nodes.set_velocity(i, Vec3::from((Vec3A::from(target) - x) / dt));
+            // Steering a held node is part of the step, not a change from outside it (which
+            // would restart BDF2's history); pinning and releasing above are.
+            let _ = nodes
+                .bypass_change_detection()
+                .set_velocity(i, Vec3::from((Vec3A::from(target) - x) / dt));
         }
     }
 }

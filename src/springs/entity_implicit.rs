@@ -3,7 +3,7 @@
 //!
 //! A spring is solved implicitly when the global [`Integrator`] is
 //! [`Integrator::ImplicitEuler`], when it carries an [`ImplicitEuler`] component (put there by
-//! game code, or by [`super::StabilityPolicy::SwitchToImplicit`] when the spring is too stiff
+//! game code, or by [`crate::integrator::StabilityPolicy`] when the spring is too stiff
 //! for the substep), and both its ends are integrated by a scheme that kicks then drifts
 //! (symplectic or backward Euler; a pinned end always qualifies). Every such spring of the
 //! world goes into one solve, the same Newton and conjugate-gradient machinery as spring
@@ -40,7 +40,9 @@ use super::{Spinning, Spring, SpringNetwork, anchor_state};
 use crate::core::quarantine::{DivergenceGuard, QuarantineReason, Quarantined};
 use crate::core::time::SubstepTime;
 use crate::integrator::implicit::{Scratch, step};
-use crate::integrator::{ImplicitEuler, ImplicitState, Integrator, IntegratorOverride};
+use crate::integrator::{
+    ImplicitEuler, ImplicitScheme, ImplicitState, Integrator, IntegratorOverride,
+};
 use crate::particles::{Force, LinearVelocity, Mass, Nodes, Position};
 use crate::rigid::{Inertia, Torque};
 
@@ -79,7 +81,9 @@ struct End {
     /// How far the anchor's path over the step curves off the straight line x + h v as the
     /// body turns at its present spin: R(h ω) r − r − h ω × r (m).
     curve: Vec3A,
-    /// The end's velocity at the step's start and its share of the body's other forces.
+    /// The end's position and velocity at the step's start and its share of the body's
+    /// other forces.
+    x0: Vec3A,
     v0: Vec3A,
     f_ext: Vec3A,
 }
@@ -102,6 +106,9 @@ pub(crate) struct EntitySolve {
 pub(crate) struct EntitySpringFactor {
     last_ends: Vec<[u32; 2]>,
     state: ImplicitState,
+    /// BDF2's position corrections of this substep, per body (see [`correct_end_positions`]).
+    #[serde(skip)]
+    corrections: Vec<(Entity, Vec3A)>,
 }
 
 impl EntitySolve {
@@ -141,6 +148,7 @@ impl EntitySolve {
             inverse_inertia: glam::Mat3A::ZERO,
             mobility: 0.0,
             curve: Vec3A::ZERO,
+            x0: x,
             v0: v,
             f_ext: Vec3A::ZERO,
         });
@@ -272,7 +280,16 @@ pub(crate) fn solve_entity_springs(
         kept.state = ImplicitState::default();
         kept.last_ends.clone_from(&s.network.ends);
     }
-    let settings = settings.unwrap_or_default();
+    let mut settings = settings.unwrap_or_default();
+    if s.ends.iter().any(|e| e.lever != Vec3A::ZERO) {
+        // BDF2's correction moves a body, not its anchor: off the centre of mass it would
+        // need an orientation correction too, and without one the swing gains energy.
+        settings.scheme = ImplicitScheme::BackwardEuler;
+    }
+    // The ends' positions are the bodies', rounded by their own integrators: there is no
+    // sub-ulp remainder of the solve to carry.
+    kept.state.remainder.clear();
+    kept.corrections.clear();
     let report = step(
         &mut s.network,
         &mut s.nodes,
@@ -321,6 +338,27 @@ pub(crate) fn solve_entity_springs(
             && let Ok(mut t) = torques.get_mut(end.body)
         {
             t.bypass_change_detection().0 += end.lever.cross(f);
+        }
+        if settings.scheme == ImplicitScheme::Bdf2 {
+            // The kick lands the end on v₁ and the drift on x₀ + h v₁; BDF2's x₁ is
+            // (4x₀ − x₋₁)/3 + ⅔h v₁. A body with several ends takes their mean.
+            let share = 1.0 / s.anchors_per_body[&end.body] as f32;
+            let delta = s.nodes.x[i] - (end.x0 + h * s.nodes.v[i]);
+            kept.corrections.push((end.body, share * delta));
+        }
+    }
+}
+
+/// Moves each body by BDF2's position correction of its ends, before the bodies drift: the
+/// force handed over sets an end's velocity, and a velocity alone would land it on the
+/// symplectic drift x₀ + h v₁, a scheme that is unstable past ωh ≈ 4.
+pub(crate) fn correct_end_positions(
+    mut kept: ResMut<EntitySpringFactor>,
+    mut positions: Query<&mut Position, Without<Quarantined>>,
+) {
+    for (body, delta) in kept.bypass_change_detection().corrections.drain(..) {
+        if let Ok(mut p) = positions.get_mut(body) {
+            p.bypass_change_detection().0 += delta;
         }
     }
 }

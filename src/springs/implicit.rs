@@ -187,6 +187,10 @@ pub(crate) fn solve_implicit_springs(
     mut scratch: Local<Scratch<SpringNetwork>>,
 ) {
     for (e, mut nodes, mut network, settings, mut state) in &mut meshes {
+        if nodes.is_changed() {
+            // Moved from outside the step (spawned, teleported): no history to extrapolate.
+            state.bypass_change_detection().history_h = 0.0;
+        }
         let network = network.bypass_change_detection();
         let n = nodes.bypass_change_detection();
         if !network.fits(n) {

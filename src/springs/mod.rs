@@ -41,7 +41,7 @@ pub use builders::{Chain, ChainBuilder};
 pub(crate) use entity_implicit::EntitySpringFactor;
 pub use plugin::SpringPlugin;
 pub(crate) use plugin::{Spinning, anchor_state};
-pub use stability::{EntitySpringStability, SpringStability, StabilityPolicy, StabilityWarning};
+pub use stability::{EntitySpringStability, SpringStability};
 
 use bevy_ecs::lifecycle::HookContext;
 use bevy_ecs::prelude::*;

@@ -39,7 +39,11 @@ impl WorldPlugin for SpringPlugin {
         add_own_systems(
             world,
             crate::core::schedule::SubstepSchedule,
-            super::entity_implicit::solve_entity_springs
+            (
+                super::entity_implicit::solve_entity_springs,
+                super::entity_implicit::correct_end_positions,
+            )
+                .chain()
                 .run_if(any_with_component::<Spring>)
                 .in_set(ForceSystems::ImplicitSprings),
         );
@@ -52,8 +56,6 @@ impl WorldPlugin for SpringPlugin {
         );
         crate::core::restore::init::<super::EntitySpringStability>(world);
         crate::core::restore::init::<super::entity_implicit::EntitySpringFactor>(world);
-        crate::core::restore::init::<super::StabilityPolicy>(world);
-        crate::core::plugin::add_message::<super::StabilityWarning>(world);
         add_own_systems(
             world,
             PhysicsSchedule,

@@ -1,33 +1,27 @@
 //! The explicit stability limit of spring systems, told.
 //!
-//! Symplectic Euler on an undamped oscillator of frequency ω is stable for h < 2/ω. For a
-//! spring system the highest frequency ω_max is bounded by Gershgorin's row sums of
-//! M^(−1/2) K M^(−1/2), K the springs' stiffness matrix (k d̂ d̂ᵀ blocks, |d̂ d̂ᵀ| ≤ 1):
+//! For a spring system the highest frequency ω_max is bounded by Gershgorin's row sums of
+//! M^(−1/2) K M^(−1/2), K the springs' stiffness matrix (k d̂ d̂ᵀ blocks, |d̂ d̂ᵀ| ≤ 1), and its
+//! damping rate by the same sums of the damping matrix:
 //!
 //! ```text
-//! ω_max² ≤ max over free nodes i of  Σ_{springs (i, j)} ( k / m_i + k / √(m_i m_j) )
-//! h_crit = 2 / ω_max,   and with damping also h < 2 m_i / Σ c   (the drag's own limit)
+//! K = max over free nodes i of  Σ_{springs (i, j)} k (1/m_i + 1/√(m_i m_j))
+//! C = the same sum with the damping c
+//! h_crit = (√(C² + 4K) − C) / K      (see crate::integrator::stability)
 //! ```
 //!
-//! The bound is exact for one spring between two free masses (ω² = k (1/m_a + 1/m_b)) and for
-//! a long uniform chain (ω_max → 2 √(k/m)). A pinned end counts as infinitely heavy.
+//! The bound is exact for one damped spring between two free masses (ω² = k (1/m_a + 1/m_b),
+//! 2ζω = c (1/m_a + 1/m_b)) and for a long uniform chain (ω_max → 2 √(k/m)). A pinned end
+//! counts as infinitely heavy.
 //!
 //! Each [`SpringNetwork`] mesh carries its limit in [`SpringStability`], and the entity
 //! springs share one in [`EntitySpringStability`]; both are recomputed when springs or
 //! masses change. When the configured substep dt / substeps exceeds a system's limit under
-//! an explicit integrator, a [`StabilityWarning`] is written once for that system with the
-//! substeps it needs, and [`crate::core::diagnostics::PhysicsDiagnostics::stability_warnings`] counts it.
-//! Past the limit the springs diverge within a few steps, and [`crate::core::quarantine::DivergenceGuard`]
-//! quarantines what runs away.
-//!
-//! **[`StabilityPolicy`]** decides what happens to such a system. The default,
-//! [`StabilityPolicy::SwitchToImplicit`], puts an [`ImplicitEuler`] on it (the mesh entity,
-//! or each [`Spring`] entity touching a node past its limit) so it is solved by backward
-//! Euler from that step on, stable at any stiffness: a game developer's stiff rope just
-//! works at 60 Hz. It acts on systems integrated by [`Integrator::SymplecticEuler`] (the
-//! default); a system given another integrator on purpose keeps it and is only warned, as
-//! under [`StabilityPolicy::Warn`]. The warning says which happened
-//! ([`StabilityWarning::solved_implicitly`]).
+//! an explicit integrator, [`StabilityPolicy`] decides (by default: solved by BDF2 from then on),
+//! a [`StabilityWarning`] is written once for that system with the substeps it needs, and
+//! [`crate::core::diagnostics::PhysicsDiagnostics::stability_warnings`] counts it. Past the
+//! limit, explicit springs diverge within a few steps, and
+//! [`crate::core::quarantine::DivergenceGuard`] quarantines what runs away.
 
 use std::collections::HashMap;
 
@@ -36,7 +30,10 @@ use bevy_ecs::prelude::*;
 use super::{Spring, SpringNetwork};
 use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::time::PhysicsTime;
-use crate::integrator::{ImplicitEuler, Integrator, IntegratorOverride};
+use crate::integrator::stability::{
+    StabilityPolicy, StabilityWarning, critical_step, substeps_needed,
+};
+use crate::integrator::{ImplicitEuler, ImplicitScheme, Integrator, IntegratorOverride};
 use crate::particles::{Mass, Nodes};
 
 /// A [`SpringNetwork`] mesh's explicit stability limit (see the module docs).
@@ -68,67 +65,10 @@ pub struct EntitySpringStability {
     substep: f32,
 }
 
-/// What hooke does with a spring system whose explicit stability limit is below the substep
-/// (see [`crate::springs::stability`]). A resource.
-#[derive(
-    serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Default,
-)]
-pub enum StabilityPolicy {
-    /// Solve it with backward Euler from then on ([`ImplicitEuler`] is inserted on it), and
-    /// write a [`StabilityWarning`] saying so. The default.
-    #[default]
-    SwitchToImplicit,
-    /// Keep integrating it explicitly and write a [`StabilityWarning`]; the
-    /// [`crate::core::quarantine::DivergenceGuard`] catches what then runs away.
-    Warn,
-}
-
-/// Written once per spring system whose explicit stability limit is below the substep.
-#[derive(Message, Debug, Clone, PartialEq)]
-pub struct StabilityWarning {
-    /// The [`SpringNetwork`] mesh, or the spring entity at the stiffest node.
-    pub entity: Entity,
-    /// Its limit h_crit (s).
-    pub critical_step: f32,
-    /// The configured substep dt / substeps (s).
-    pub substep: f32,
-    /// Substeps per step that would keep it stable under the explicit integrators.
-    pub substeps_needed: u32,
-    /// Whether [`StabilityPolicy::SwitchToImplicit`] switched it to backward Euler.
-    pub solved_implicitly: bool,
-}
-
-impl StabilityWarning {
-    /// The advice, as a sentence.
-    #[must_use]
-    pub fn advice(&self) -> String {
-        if self.solved_implicitly {
-            format!(
-                "spring system {:?} is too stiff for explicit integration (substep {:.2e} s > its limit {:.2e} s): it is solved by backward Euler from now on; {} substeps would keep it explicit",
-                self.entity, self.substep, self.critical_step, self.substeps_needed
-            )
-        } else {
-            format!(
-                "spring system {:?} is unstable under explicit integration: substep {:.2e} s > its limit {:.2e} s; use {} substeps or backward Euler (ImplicitEuler)",
-                self.entity, self.substep, self.critical_step, self.substeps_needed
-            )
-        }
-    }
-}
-
-/// h_crit from per-node Σ(k/m_i + k/√(m_i m_j)) and Σ c (see the module docs).
-fn limit(rows: impl Iterator<Item = (f32, f32, f32)>) -> f32 {
-    // (stiffness row sum, damping sum, mass) per node.
-    let mut h = f32::INFINITY;
-    for (kk, cc, m) in rows {
-        if kk > 0.0 {
-            h = h.min(2.0 / kk.sqrt());
-        }
-        if cc > 0.0 {
-            h = h.min(2.0 * m / cc);
-        }
-    }
-    h
+/// h_crit from per-node (stiffness row sum, damping row sum): the smallest node limit.
+fn limit(rows: impl Iterator<Item = (f32, f32)>) -> f32 {
+    rows.map(|(k, c)| critical_step(k, c))
+        .fold(f32::INFINITY, f32::min)
 }
 
 impl SpringNetwork {
@@ -147,19 +87,19 @@ impl SpringNetwork {
             let cross = (wa * wb).sqrt();
             kk[a] += self.k[s] * (wa + cross);
             kk[b] += self.k[s] * (wb + cross);
-            cc[a] += self.c[s];
-            cc[b] += self.c[s];
+            cc[a] += self.c[s] * (wa + cross);
+            cc[b] += self.c[s] * (wb + cross);
         }
         limit(
             (0..n)
                 .filter(|&i| nodes.inv_mass[i] > 0.0)
-                .map(|i| (kk[i], cc[i], 1.0 / nodes.inv_mass[i])),
+                .map(|i| (kk[i], cc[i])),
         )
     }
 }
 
 /// Recomputes the limits that springs or masses changed, and warns once per system past it
-/// (switching it to backward Euler under [`StabilityPolicy::SwitchToImplicit`]).
+/// (switching it to an implicit scheme as [`StabilityPolicy`] says).
 #[allow(clippy::type_complexity, clippy::too_many_arguments)] // the change filters are the point
 pub(crate) fn check_stability(
     mut commands: Commands,
@@ -185,23 +125,23 @@ pub(crate) fn check_stability(
     mut diag: Option<ResMut<PhysicsDiagnostics>>,
 ) {
     let global = *global;
-    let switch = policy.is_none_or(|p| *p == StabilityPolicy::SwitchToImplicit);
+    let policy = policy.map_or_else(StabilityPolicy::default, |p| *p);
     let substep = time.dt() / time.substeps() as f32;
-    let needed = |h_crit: f32| ((time.dt() / (0.9 * h_crit)).ceil() as u32).max(1);
     let mut smallest = f32::INFINITY;
     let mut warn = |entity: Entity,
                     h_crit: f32,
-                    solved_implicitly: bool,
+                    rescue: Option<crate::integrator::ImplicitScheme>,
                     diag: &mut Option<ResMut<PhysicsDiagnostics>>| {
         warnings.write(StabilityWarning {
             entity,
             critical_step: h_crit,
             substep,
-            substeps_needed: needed(h_crit),
-            solved_implicitly,
+            substeps_needed: substeps_needed(time.dt(), h_crit),
+            rescue,
         });
         if let Some(d) = diag {
             d.stability_warnings += 1;
+            d.rescued += u64::from(rescue.is_some());
         }
     };
     let implicit_dial = global == Integrator::ImplicitEuler;
@@ -213,12 +153,14 @@ pub(crate) fn check_stability(
         smallest = smallest.min(stability.critical_step);
         if !implicit && !implicit_dial && !stability.warned && substep > stability.critical_step {
             stability.warned = true;
-            let method = o.map_or(global, |o| o.0);
-            let solved_implicitly = switch && method == Integrator::SymplecticEuler;
-            if solved_implicitly {
-                commands.entity(e).insert(ImplicitEuler::default());
+            let rescue = policy.rescue(o.map_or(global, |o| o.0));
+            if let Some(scheme) = rescue {
+                commands.entity(e).insert(ImplicitEuler {
+                    scheme,
+                    ..ImplicitEuler::default()
+                });
             }
-            warn(e, stability.critical_step, solved_implicitly, &mut diag);
+            warn(e, stability.critical_step, rescue, &mut diag);
         }
     }
     // The entity springs integrated explicitly; the implicit ones have no limit.
@@ -236,7 +178,7 @@ pub(crate) fn check_stability(
         // Per end (a body, and an anchor on it): its stiffness row, damping sum and inverse
         // mass. An anchor at lever r on a rigid body moves under a force as fast as a mass
         // 1/(1/m + |r|²/I_min) would (the angular response bounded, as in the implicit solve).
-        let mut rows: HashMap<(Entity, [u32; 3]), (f32, f32, f32)> = HashMap::new();
+        let mut rows: HashMap<(Entity, [u32; 3]), (f32, f32)> = HashMap::new();
         let inverse = |e: Entity, anchor: glam::Vec3| {
             let w = masses.get(e).map_or(0.0, |m| m.0.inverse());
             match inertias.get(e) {
@@ -253,17 +195,28 @@ pub(crate) fn check_stability(
                 if w > 0.0 {
                     let row = rows.entry(end).or_default();
                     row.0 += s.stiffness() * (w + cross);
-                    row.1 += s.damping();
-                    row.2 = w;
+                    row.1 += s.damping() * (w + cross);
                 }
             }
         }
-        let node_limit = |end: (Entity, [u32; 3])| {
-            rows.get(&end)
-                .map(|&(kk, cc, w)| limit([(kk, cc, 1.0 / w)].into_iter()))
-        };
+        let node_limit =
+            |end: (Entity, [u32; 3])| rows.get(&end).map(|&(kk, cc)| critical_step(kk, cc));
         let mut best = (f32::INFINITY, None);
         let mut stiff = Vec::new();
+        // Springs anchored off a turning body's centre are solved by backward Euler (see
+        // `entity_implicit`), and they share one solve with the rest.
+        let levered = springs.iter().any(|(_, s, _)| {
+            let (a, b) = s.anchors();
+            (a != glam::Vec3::ZERO && inertias.contains(s.a()))
+                || (b != glam::Vec3::ZERO && inertias.contains(s.b()))
+        });
+        let rescue = policy.rescue(Integrator::SymplecticEuler).map(|scheme| {
+            if levered {
+                ImplicitScheme::BackwardEuler
+            } else {
+                scheme
+            }
+        });
         for (e, s, _) in springs.iter().filter(|s| explicit(s.2)) {
             let mut over = false;
             let (anchor_a, anchor_b) = s.anchors();
@@ -282,7 +235,7 @@ pub(crate) fn check_stability(
                     m.is_pinned() || o.map_or(global, |o| o.0) == Integrator::SymplecticEuler
                 })
             };
-            if over && switch && symplectic(s.a()) && symplectic(s.b()) {
+            if over && rescue.is_some() && symplectic(s.a()) && symplectic(s.b()) {
                 stiff.push(e);
             }
         }
@@ -293,10 +246,20 @@ pub(crate) fn check_stability(
             && substep > best.0
         {
             entity_limit.warned = true;
-            warn(spring, best.0, stiff.contains(&spring), &mut diag);
+            warn(
+                spring,
+                best.0,
+                rescue.filter(|_| stiff.contains(&spring)),
+                &mut diag,
+            );
         }
-        for e in stiff {
-            commands.entity(e).insert(ImplicitEuler::default());
+        if let Some(scheme) = rescue {
+            for e in stiff {
+                commands.entity(e).insert(ImplicitEuler {
+                    scheme,
+                    ..ImplicitEuler::default()
+                });
+            }
         }
     }
     smallest = smallest.min(entity_limit.critical_step);

@@ -45,6 +45,9 @@ pub(crate) fn soft_response(
         return g;
     };
     let len = n.x.len();
+    // The factor's own step: BDF2 solves with ⅔ of the substep. An impulse J changes the
+    // velocities by H⁻¹ J / h_f² (whose total is exactly J: K moves no mass centre).
+    let h = if factor.step > 0.0 { factor.step } else { h };
     let inv_h2 = 1.0 / (f64::from(h) * f64::from(h));
     let (mut e, mut z, mut work) = (vec![DVec3::ZERO; len], vec![DVec3::ZERO; len], vec![]);
     for (l, &(j, d)) in rows.iter().enumerate() {
@@ -75,17 +78,18 @@ pub(crate) fn move_soft(
         return;
     };
     let len = n.x.len();
+    let hf = f64::from(if factor.step > 0.0 { factor.step } else { h });
     let mut rhs = vec![DVec3::ZERO; len];
     for &(i, j) in impulses {
-        rhs[i] += j.as_dvec3() / f64::from(h);
+        rhs[i] += j.as_dvec3() / (hf * hf);
     }
-    let mut dx = vec![DVec3::ZERO; len];
-    factor.solve(&rhs, &mut dx, &mut Vec::new());
-    for (i, dx) in dx.iter().enumerate() {
+    let mut dv = vec![DVec3::ZERO; len];
+    factor.solve(&rhs, &mut dv, &mut Vec::new());
+    for (i, dv) in dv.iter().enumerate() {
         if n.inv_mass[i] > 0.0 {
-            let d = Vec3A::from(dx.as_vec3());
-            n.x[i] += d;
-            n.v[i] += d / h;
+            let d = Vec3A::from(dv.as_vec3());
+            n.v[i] += d;
+            n.x[i] += Vec3A::from((f64::from(h) * *dv).as_vec3());
         }
     }
 }

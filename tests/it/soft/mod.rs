@@ -5,4 +5,5 @@ mod contact_two_way;
 mod implicit;
 mod mesh_files;
 mod soft_body;
+mod stable_at_the_defaults;
 mod strain;

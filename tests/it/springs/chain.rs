@@ -132,7 +132,8 @@ fn a_rope_between_two_pins_hangs_on_the_catenary() {
     build().spawn(&mut probe).unwrap();
     probe.step_physics();
     let needed = {
-        let m = probe.resource::<bevy_ecs::message::Messages<hooke::springs::StabilityWarning>>();
+        let m =
+            probe.resource::<bevy_ecs::message::Messages<hooke::integrator::StabilityWarning>>();
         m.get_cursor().read(m).next().unwrap().substeps_needed
     };
     let mut w = hooke::tools::scenes::world_with(

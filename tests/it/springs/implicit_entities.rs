@@ -9,11 +9,11 @@ use bevy_ecs::prelude::*;
 use glam::Vec3;
 use hooke::core::quarantine::Quarantined;
 use hooke::core::time::PhysicsTime;
-use hooke::integrator::ImplicitEuler;
+use hooke::integrator::StabilityPolicy;
+use hooke::integrator::StabilityWarning;
+use hooke::integrator::{ImplicitEuler, ImplicitScheme};
 use hooke::prelude::*;
 use hooke::springs::ChainBuilder;
-use hooke::springs::StabilityPolicy;
-use hooke::springs::StabilityWarning;
 use hooke::tools::scenes;
 
 fn warnings(w: &World) -> Vec<StabilityWarning> {
@@ -83,17 +83,17 @@ fn stiff_rope() -> ChainBuilder {
 use common::default_world;
 
 #[test]
-fn a_stiff_rope_just_works_at_the_defaults_the_policy_switches_it_to_backward_euler() {
+fn a_stiff_rope_just_works_at_the_defaults_the_policy_switches_it_to_bdf2() {
     let mut w = default_world();
     assert_eq!(
         *w.resource::<StabilityPolicy>(),
-        StabilityPolicy::SwitchToImplicit
+        StabilityPolicy::SwitchToImplicit(ImplicitScheme::Bdf2)
     );
     let rope = stiff_rope().spawn(&mut w).unwrap();
     w.step_physics();
     let told = warnings(&w);
     assert_eq!(told.len(), 1, "{told:?}");
-    assert!(told[0].solved_implicitly);
+    assert_eq!(told[0].rescue, Some(ImplicitScheme::Bdf2));
     println!("{}", told[0].advice());
     for &s in &rope.springs {
         assert!(
@@ -141,11 +141,15 @@ fn a_stiff_rope_hung_straight_comes_to_rest_with_each_spring_carrying_the_weight
         .fold(0.0f32, f32::max);
     println!("hung straight, after 5 s: fastest node {speed:.2e} m/s");
     assert!(speed < 1e-3, "comes to rest: {speed} m/s");
+    // A reading from f32 positions resolves the tension to k · ulp(y): 0.044 N at 1 m (the
+    // solve carries positions below an ulp, which the reading does not see).
+    let k = 20.0 * 0.1 * 9.81 / (1e-3 / 19.0);
     for (i, &s) in rope.springs.iter().enumerate() {
         let r = w.get::<Spring>(s).unwrap().reading(&w).unwrap();
         let below = (19 - i) as f32 * 0.1 * 9.81;
+        let floor = k * f32::EPSILON;
         assert!(
-            (r.tension / below - 1.0).abs() < 0.02,
+            (r.tension - below).abs() < 0.02 * below + floor,
             "spring {i}: {} N vs {below} N",
             r.tension
         );
@@ -160,7 +164,7 @@ fn under_the_warn_policy_the_stiff_rope_stays_explicit_and_the_guard_catches_it(
     w.step_physics();
     let told = warnings(&w);
     assert_eq!(told.len(), 1);
-    assert!(!told[0].solved_implicitly);
+    assert_eq!(told[0].rescue, None);
     for _ in 0..4 {
         w.step_physics();
     }
@@ -219,7 +223,7 @@ fn a_rigid_box_on_a_stiff_spring_at_its_centre_hangs_at_the_static_stretch() {
     w.step_physics();
     let told = warnings(&w);
     assert_eq!(told.len(), 1);
-    assert!(told[0].solved_implicitly);
+    assert_eq!(told[0].rescue, Some(ImplicitScheme::Bdf2));
     let mut farthest = 0.0f32;
     for _ in 0..600 {
         w.step_physics();
@@ -265,7 +269,8 @@ fn a_box_hung_off_centre_by_a_stiff_spring_swings_without_gaining_energy() {
     let e0 = total_energy(&w);
     let told = warnings(&w);
     assert_eq!(told.len(), 1, "the lever arm lowers the limit: {told:?}");
-    assert!(told[0].solved_implicitly);
+    // Anchored off the centre: backward Euler (BDF2 would need an orientation correction).
+    assert_eq!(told[0].rescue, Some(ImplicitScheme::BackwardEuler));
     let (mut most, mut strain) = (f64::NEG_INFINITY, 0.0f32);
     for _ in 0..1200 {
         w.step_physics();

@@ -14,16 +14,16 @@ use hooke::core::quarantine::DivergenceGuard;
 use hooke::core::quarantine::QuarantineReason;
 use hooke::core::quarantine::Quarantined;
 use hooke::core::time::PhysicsTime;
+use hooke::integrator::StabilityWarning;
 use hooke::prelude::*;
 use hooke::springs::SpringStability;
-use hooke::springs::StabilityWarning;
 use hooke::tools::scenes;
 
 /// The defaults, but springs past their limit stay explicit.
 fn default_world() -> World {
     let mut w = World::new();
     w.add_physics(PhysicsPlugins);
-    w.insert_resource(hooke::springs::StabilityPolicy::Warn);
+    w.insert_resource(hooke::integrator::StabilityPolicy::Warn);
     w
 }
 
@@ -150,7 +150,7 @@ fn the_critical_step_of_a_two_mass_spring_is_the_closed_form_and_is_the_edge() {
     for (factor, stable) in [(0.95f32, true), (1.05, false)] {
         let mut w = scenes::world_with(factor * closed, 1, Integrator::SymplecticEuler, Vec3::ZERO)
             .unwrap();
-        w.insert_resource(hooke::springs::StabilityPolicy::Warn);
+        w.insert_resource(hooke::integrator::StabilityPolicy::Warn);
         let e = w.spawn((nodes.clone(), net.clone())).id();
         let mut peak = 0.0f32;
         for _ in 0..2000 {

@@ -1,0 +1,123 @@
+//! A soft body's explicit stability limit, and the policy on it.
+//!
+//! By Irons' theorem the highest frequency of an assembled mesh is at most the highest of
+//! its elements with their lumped masses (ρV/4 per corner). For a tetrahedron the strain
+//! energy is V ψ(ε) with 2ψ ≤ (2μ + 3λ) |ε|² (the bulk mode's ratio, the largest for
+//! λ ≥ 0) and |ε|² ≤ |∇u|² ≤ Σ|u_i|² Σ|∇N_i|², so
+//!
+//! ```text
+//! ω_max² ≤ max over elements of 4 (2μ + 3λ) Σᵢ |∇Nᵢ|² / ρ,       2ζω ≤ α + β ω²
+//! ```
+//!
+//! and h_crit follows from [`crate::integrator::stability::critical_step`]. The bound is
+//! safe (never above the true limit) and on regular meshes 2–3 times below it, so a body
+//! near its limit is solved implicitly rather than risked.
+//!
+//! A [`SoftBody`] integrated explicitly past its limit is handled by
+//! [`crate::integrator::StabilityPolicy`] (by default solved by BDF2 from then on), told once
+//! by a [`StabilityWarning`].
+
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+
+use super::SoftBody;
+use crate::core::diagnostics::PhysicsDiagnostics;
+use crate::core::quarantine::Quarantined;
+use crate::core::time::PhysicsTime;
+use crate::integrator::stability::{
+    StabilityPolicy, StabilityWarning, critical_step, substeps_needed,
+};
+use crate::integrator::{ImplicitEuler, Integrator, IntegratorOverride};
+
+/// A soft body's explicit stability limit (see the module docs); added with [`SoftBody`].
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
+)]
+pub struct SoftStability {
+    /// The largest substep (s) explicit integration is sure to be stable at.
+    pub critical_step: f32,
+    computed: bool,
+    warned: bool,
+}
+
+impl SoftBody {
+    /// The explicit stability limit h_crit (s) of this body at rest (see
+    /// [`crate::soft::stability`]); infinite for a body without elements.
+    #[must_use]
+    pub fn critical_step(&self) -> f32 {
+        let lame = self.lame;
+        let modulus = 2.0 * lame.mu + 3.0 * lame.lambda.max(0.0);
+        let (alpha, beta) = self.material.damping();
+        let mut g_max = 0.0f32;
+        for dm_inv in &self.dm_inv {
+            let rows = [dm_inv.row(0), dm_inv.row(1), dm_inv.row(2)];
+            let first: Vec3 = -(rows[0] + rows[1] + rows[2]);
+            let g = first.length_squared() + rows.iter().map(|r| r.length_squared()).sum::<f32>();
+            g_max = g_max.max(g);
+        }
+        let k = 4.0 * modulus * g_max / self.material.density();
+        critical_step(k, alpha + beta * k)
+    }
+}
+
+/// Computes each soft body's limit once, and applies the policy to one past it.
+#[allow(clippy::type_complexity)] // the filters are the point
+pub(crate) fn check_soft_stability(
+    mut commands: Commands,
+    time: Res<PhysicsTime>,
+    global: Res<Integrator>,
+    policy: Option<Res<StabilityPolicy>>,
+    mut bodies: Query<
+        (
+            Entity,
+            Ref<SoftBody>,
+            &mut SoftStability,
+            Has<ImplicitEuler>,
+            Option<&IntegratorOverride>,
+        ),
+        Without<Quarantined>,
+    >,
+    mut warnings: MessageWriter<StabilityWarning>,
+    mut diag: Option<ResMut<PhysicsDiagnostics>>,
+) {
+    let policy = policy.map_or_else(StabilityPolicy::default, |p| *p);
+    let substep = time.dt() / time.substeps() as f32;
+    let mut smallest = f32::INFINITY;
+    for (e, body, mut stability, implicit, o) in &mut bodies {
+        if !stability.computed || body.is_changed() {
+            stability.critical_step = body.critical_step();
+            stability.computed = true;
+        }
+        smallest = smallest.min(stability.critical_step);
+        let method = o.map_or(*global, |o| o.0);
+        if implicit
+            || method == Integrator::ImplicitEuler
+            || stability.warned
+            || substep <= stability.critical_step
+        {
+            continue;
+        }
+        stability.warned = true;
+        let rescue = policy.rescue(method);
+        if let Some(scheme) = rescue {
+            commands.entity(e).insert(ImplicitEuler {
+                scheme,
+                ..ImplicitEuler::default()
+            });
+        }
+        warnings.write(StabilityWarning {
+            entity: e,
+            critical_step: stability.critical_step,
+            substep,
+            substeps_needed: substeps_needed(time.dt(), stability.critical_step),
+            rescue,
+        });
+        if let Some(d) = diag.as_mut() {
+            d.stability_warnings += 1;
+            d.rescued += u64::from(rescue.is_some());
+        }
+    }
+    if let Some(d) = diag.as_mut() {
+        d.soft_critical_step = smallest;
+    }
+}

@@ -1,0 +1,157 @@
+//! What the default rescue keeps. A system too stiff for the substep is switched to BDF2
+//! (`StabilityPolicy`'s default), which damps only the motions too fast for the step: at the
+//! defaults (`PhysicsPlugins` and nothing else) a pendulum on a stiff rod keeps its period and
+//! swing, and a taut string its tone. Backward Euler, the previous rescue, took 40% of the
+//! pendulum's swing in 14 s and 72% of the string's amplitude per period.
+
+use crate::common;
+
+use bevy_ecs::message::Messages;
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use hooke::integrator::{ImplicitScheme, StabilityWarning};
+use hooke::prelude::*;
+use hooke::springs::ChainBuilder;
+
+fn told(w: &World) -> Vec<StabilityWarning> {
+    let m = w.resource::<Messages<StabilityWarning>>();
+    m.get_cursor().read(m).cloned().collect()
+}
+
+/// K(m), the complete elliptic integral of the first kind, by the arithmetic–geometric mean.
+fn elliptic_k(m: f64) -> f64 {
+    let (mut a, mut b) = (1.0f64, (1.0 - m).sqrt());
+    for _ in 0..30 {
+        (a, b) = (0.5 * (a + b), (a * b).sqrt());
+    }
+    std::f64::consts::PI / (2.0 * a)
+}
+
+#[test]
+fn a_pendulum_on_a_stiff_rod_keeps_its_period_and_swing_at_the_defaults() {
+    // 1 kg on a 1 m spring of 1e6 N/m: the rod's own mode is 1000 rad/s, h_crit = 2 ms, past
+    // the default 1/240 s substep. Released from rest at 90°.
+    let mut w = common::default_world();
+    let pin = w.spawn(ParticleBundle::pinned(Vec3::ZERO).unwrap()).id();
+    let bob = w
+        .spawn(ParticleBundle::new(Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO, 1.0).unwrap())
+        .id();
+    Spring::from_hooke(pin, bob, 1.0, 1e6, 0.0)
+        .unwrap()
+        .spawn(&mut w)
+        .unwrap();
+    let g = 9.81f64;
+    // 4 √(L/g) K(sin²(θ₀/2)) at θ₀ = 90°.
+    let period = 4.0 * (1.0 / g).sqrt() * elliptic_k(0.5);
+    let steps = (10.0 * period * 60.0).ceil() as usize + 30;
+    let (mut crossings, mut last_x, mut t) = (Vec::new(), 1.0f32, 0.0f64);
+    let mut swing = Vec::new();
+    for step in 0..steps {
+        if step == 1 {
+            let first = told(&w);
+            assert_eq!(first.len(), 1, "{first:?}");
+            assert_eq!(first[0].rescue, Some(ImplicitScheme::Bdf2));
+            println!("{}", first[0].advice());
+        }
+        w.step_physics();
+        t += 1.0 / 60.0;
+        let x = common::x(&w, bob);
+        if last_x < 0.0 && x.x >= 0.0 {
+            crossings.push(t - 1.0 / 60.0 * f64::from(x.x / (x.x - last_x)));
+        }
+        last_x = x.x;
+        swing.push((t, x.x.atan2(-x.y).abs()));
+    }
+    let warning = &told(&w)[..];
+    assert_eq!(
+        warning.len(),
+        0,
+        "the warning of the first step has rotated out"
+    );
+    let d = w.resource::<PhysicsDiagnostics>();
+    assert_eq!(d.rescued, 1, "switched once, and the count persists");
+    assert_eq!(d.quarantined_total, 0);
+    assert!(crossings.len() >= 10, "{crossings:?}");
+    let measured = (crossings[9] - crossings[0]) / 9.0;
+    // The swing in the tenth period.
+    let start = crossings[0] + 8.0 * period;
+    let amplitude = swing
+        .iter()
+        .filter(|(t, _)| *t >= start && *t < start + period)
+        .map(|s| s.1)
+        .fold(0.0f32, f32::max)
+        .to_degrees();
+    println!(
+        "stiff-rod pendulum at the defaults: period {measured:.4} s (closed {period:.4} s, {:+.2}%), swing in the 10th period {amplitude:.2}° of 90°",
+        100.0 * (measured / period - 1.0)
+    );
+    assert!((measured / period - 1.0).abs() < 0.01, "{measured}");
+    assert!(amplitude > 0.95 * 90.0, "{amplitude}");
+}
+
+#[test]
+fn a_taut_string_keeps_its_tone_at_the_defaults() {
+    // A string strung vertically between pins 4 m apart (gravity along it, so no sag): 20
+    // beads of 10 g, 19 segments of a = 4/19 m, k = 1e4 N/m, its rest length 1.66% short:
+    // T = k a (1 − 0.9834) = 35 N (the beads' weight, 1.8 N, tilts it by ±2.5% along the
+    // string; the mean stays T). Its axial modes reach 2 √(k/m) = 2000 rad/s, h_crit = 1 ms.
+    // The beaded string's transverse modes are ω_j = 2 √(T/(m a)) sin(jπ/2n).
+    let (n, m, k, scale) = (19.0f64, 0.01f64, 1e4f64, 0.9834f64);
+    let a = 4.0 / n;
+    let tension = k * a * (1.0 - scale);
+    let omega = 2.0 * (tension / (m * a)).sqrt() * (std::f64::consts::PI / (2.0 * n)).sin();
+    let mut w = common::default_world();
+    let string = ChainBuilder::rope(Vec3::new(0.0, 5.0, 0.0), Vec3::new(0.0, 1.0, 0.0), 20)
+        .node_mass(m as f32)
+        .stiffness(k as f32)
+        .damping(0.0)
+        .pin_end(true)
+        .rest_scale(scale as f32)
+        .spawn(&mut w)
+        .unwrap();
+    // Plucked in its first mode, 1 cm at the middle.
+    let amplitude = 0.01f64;
+    for (i, &node) in string.nodes.iter().enumerate() {
+        let shape = (std::f64::consts::PI * i as f64 / n).sin();
+        w.get_mut::<LinearVelocity>(node).unwrap().0 =
+            Vec3::new((omega * amplitude * shape) as f32, 0.0, 0.0).into();
+    }
+    let middle = string.nodes[10];
+    let periods = 10.0;
+    let steps = (periods * std::f64::consts::TAU / omega * 60.0).ceil() as usize + 20;
+    let (mut crossings, mut last, mut t, mut peaks) = (Vec::new(), 0.0f32, 0.0f64, Vec::new());
+    let mut peak = 0.0f32;
+    for _ in 0..steps {
+        w.step_physics();
+        t += 1.0 / 60.0;
+        let x = common::x(&w, middle).x;
+        if last < 0.0 && x >= 0.0 {
+            crossings.push(t - 1.0 / 60.0 * f64::from(x / (x - last)));
+            peaks.push(peak);
+            peak = 0.0;
+        }
+        peak = peak.max(x.abs());
+        last = x;
+    }
+    let d = w.resource::<PhysicsDiagnostics>();
+    assert_eq!(d.rescued, 1);
+    assert_eq!(d.quarantined_total, 0);
+    let count = crossings.len() - 1;
+    let measured = std::f64::consts::TAU * count as f64 / (crossings[count] - crossings[0]);
+    // The peak per period, first full period to last.
+    let (first, last_peak) = (f64::from(peaks[1]), f64::from(peaks[peaks.len() - 1]));
+    let per_period = 1.0 - (last_peak / first).powf(1.0 / (peaks.len() - 2) as f64);
+    println!(
+        "taut string at the defaults: ω {measured:.3} rad/s (closed {omega:.3}, {:+.2}%), amplitude {:.2} → {:.2} mm over {} periods, {:.2}% lost per period",
+        100.0 * (measured / omega - 1.0),
+        first * 1e3,
+        last_peak * 1e3,
+        peaks.len() - 2,
+        100.0 * per_period
+    );
+    assert!(
+        (measured / omega - 1.0).abs() < 0.01,
+        "{measured} vs {omega}"
+    );
+    assert!(per_period < 0.05, "{per_period}");
+}
