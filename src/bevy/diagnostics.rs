@@ -23,6 +23,11 @@ impl PhysicsDiagnosticsPlugin {
     pub const RIGID_BODIES: DiagnosticPath = DiagnosticPath::const_new("hooke/rigid_bodies");
     /// Bodies quarantined since start.
     pub const QUARANTINED: DiagnosticPath = DiagnosticPath::const_new("hooke/quarantined_total");
+    /// Systems switched to an implicit scheme by the stability policy since start.
+    pub const RESCUED: DiagnosticPath = DiagnosticPath::const_new("hooke/rescued");
+    /// The energy the implicit schemes take from the motion (W): the rescue's price.
+    pub const NUMERICAL_DAMPING: DiagnosticPath =
+        DiagnosticPath::const_new("hooke/numerical_damping");
 }
 
 impl Plugin for PhysicsDiagnosticsPlugin {
@@ -31,7 +36,9 @@ impl Plugin for PhysicsDiagnosticsPlugin {
             .register_diagnostic(Diagnostic::new(Self::KINETIC_ENERGY).with_suffix("J"))
             .register_diagnostic(Diagnostic::new(Self::TOTAL_ENERGY).with_suffix("J"))
             .register_diagnostic(Diagnostic::new(Self::RIGID_BODIES))
-            .register_diagnostic(Diagnostic::new(Self::QUARANTINED));
+            .register_diagnostic(Diagnostic::new(Self::QUARANTINED))
+            .register_diagnostic(Diagnostic::new(Self::RESCUED))
+            .register_diagnostic(Diagnostic::new(Self::NUMERICAL_DAMPING).with_suffix("W"));
         let schedule = app
             .world()
             .get_resource::<AppSchedule>()
@@ -56,5 +63,9 @@ fn measure(diag: Option<Res<PhysicsDiagnostics>>, mut out: Diagnostics) {
     });
     out.add_measurement(&PhysicsDiagnosticsPlugin::QUARANTINED, || {
         d.quarantined_total as f64
+    });
+    out.add_measurement(&PhysicsDiagnosticsPlugin::RESCUED, || d.rescued as f64);
+    out.add_measurement(&PhysicsDiagnosticsPlugin::NUMERICAL_DAMPING, || {
+        d.numerical_damping
     });
 }

@@ -409,6 +409,13 @@ pub(crate) fn step<E: ImplicitElements>(
     s.hess.resize(count, E::zero());
     s.raw.resize(count, E::zero());
     s.negative.resize(count, false);
+    // The energy at the start (kinetic and elastic), for the numerical damping's account.
+    let mut energy_before = body.prepare(&s.x0, &mut s.prep_trial);
+    for i in 0..len {
+        if n.inv_mass[i] != 0.0 {
+            energy_before += 0.5 * f64::from(n.mass[i]) * d3(n.v[i]).length_squared();
+        }
+    }
     let mut elastic_now = body.prepare(&n.x, &mut s.prep);
     for it in 0..settings.max_newton {
         s.indefinite = false;
@@ -666,6 +673,37 @@ pub(crate) fn step<E: ImplicitElements>(
         } else {
             Vec3::ZERO
         };
+    }
+    // What the scheme took: the start's energy and the constant forces' work, less the
+    // model's own damping (α M and the elements' D, at the new velocity) and the end's energy.
+    let (mut work, mut energy_after, mut damped) = (0.0f64, elastic_now, 0.0f64);
+    for i in 0..len {
+        s.d[i] = DVec3::ZERO;
+        s.kd[i] = DVec3::ZERO;
+        if free[i] {
+            let m = f64::from(n.mass[i]);
+            let v = d3(n.v[i]);
+            s.d[i] = v;
+            energy_after += 0.5 * m * v.length_squared();
+            damped += alpha * m * v.length_squared();
+            let moved = d3(n.x[i]) + d3(Vec3A::from(state.remainder[i])) - d3(s.x0[i]);
+            work += d3(n.f[i]).dot(moved);
+        }
+    }
+    if !s.hess0.is_empty() {
+        let (d, mut kd) = (std::mem::take(&mut s.d), std::mem::take(&mut s.kd));
+        add_stiffness(body, &s.hess0, &d, 1.0, &mut kd);
+        damped += dot(&d, &kd);
+        (s.d, s.kd) = (d, kd);
+    }
+    let lost = energy_before + work - f64::from(h) * damped - energy_after;
+    // Averaged over about a second of simulated time (BDF2's account is not monotone step by
+    // step, only over a period).
+    let weight = (f64::from(h) / 1.0).min(1.0);
+    let rate = lost / f64::from(h);
+    if rate.is_finite() {
+        let now = f64::from(state.numerical_damping);
+        state.numerical_damping = (now + (rate - now) * weight) as f32;
     }
     s.free = free;
     // Stats at the end state, whose elements the last accepted trial prepared.

@@ -48,6 +48,15 @@ impl WorldPlugin for IntegratorPlugin {
         crate::core::restore::init::<ConstraintsActive>(world);
         crate::core::restore::init::<super::StabilityPolicy>(world);
         crate::core::plugin::add_message::<super::StabilityWarning>(world);
+        crate::core::restore::init::<super::stability::SharedNumericalDamping>(world);
+        add_own_systems(
+            world,
+            PhysicsSchedule,
+            // It writes only its own diagnostics field: its order among the reports is free.
+            super::stability::report_numerical_damping
+                .ambiguous_with_all()
+                .in_set(crate::core::schedule::FinishSystems::Writeback),
+        );
         // The whole-step path integrates rigid bodies only, with constant forces.
         crate::core::whole_step::block_on::<ExternalImpulse>(world);
         crate::core::whole_step::block_on::<ExternalImpulseAtPoint>(world);

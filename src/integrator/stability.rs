@@ -128,6 +128,26 @@ pub fn substeps_needed(dt: f32, h_crit: f32) -> u32 {
     }
 }
 
+/// The numerical damping (W) of implicit solves that live in no [`super::ImplicitState`]
+/// component (the entity springs' shared solve), for [`report_numerical_damping`].
+#[derive(Resource, Debug, Clone, Copy, Default)]
+pub(crate) struct SharedNumericalDamping(pub f32);
+
+/// Σ of every implicit solve's [`super::ImplicitState::numerical_damping`] into the diagnostics.
+pub(crate) fn report_numerical_damping(
+    states: Query<&super::ImplicitState, Without<crate::core::quarantine::Quarantined>>,
+    shared: Option<Res<SharedNumericalDamping>>,
+    diag: Option<ResMut<crate::core::diagnostics::PhysicsDiagnostics>>,
+) {
+    if let Some(mut diag) = diag {
+        diag.numerical_damping = states
+            .iter()
+            .map(|s| f64::from(s.numerical_damping))
+            .sum::<f64>()
+            + shared.map_or(0.0, |s| f64::from(s.0));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

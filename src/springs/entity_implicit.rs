@@ -171,10 +171,11 @@ pub(crate) fn solve_entity_springs(
     mut torques: Query<&mut Torque, Without<Quarantined>>,
     mut solve: Local<EntitySolve>,
     mut kept: ResMut<EntitySpringFactor>,
-    (archetypes, spring_id, mut order): (
+    (archetypes, spring_id, mut order, mut shared): (
         &bevy_ecs::archetype::Archetypes,
         bevy_ecs::component::ComponentIdFor<Spring>,
         Local<Vec<Entity>>,
+        ResMut<crate::integrator::stability::SharedNumericalDamping>,
     ),
 ) {
     let kept = &mut *kept;
@@ -247,6 +248,7 @@ pub(crate) fn solve_entity_springs(
         net.max_index = net.max_index.max(ia).max(ib);
     }
     if s.network.is_empty() {
+        shared.0 = 0.0;
         return;
     }
     let h = time.h;
@@ -302,6 +304,7 @@ pub(crate) fn solve_entity_springs(
         None => Some((QuarantineReason::NonFiniteState, None)),
         Some(report) => {
             kept.state.last = report;
+            shared.0 = kept.state.numerical_damping;
             crate::integrator::mesh_divergence(&s.nodes, &guard).map(|reason| {
                 let node = match reason {
                     QuarantineReason::Diverged {

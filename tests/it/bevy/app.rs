@@ -330,6 +330,11 @@ fn diagnostics_reach_the_diagnostics_store() {
             ),
         );
     }
+    // A rope too stiff for the substep: rescued, and the rescue's price reported.
+    hooke::springs::ChainBuilder::rope(Vec3::new(0.0, 8.0, 0.0), Vec3::new(1.0, 8.0, 0.0), 20)
+        .stiffness(3.7e5)
+        .spawn(app.world_mut())
+        .unwrap();
     app.finish();
     app.cleanup();
     frames(&mut app, 10);
@@ -338,6 +343,15 @@ fn diagnostics_reach_the_diagnostics_store() {
         .get(&PhysicsDiagnosticsPlugin::RIGID_BODIES)
         .and_then(|d| d.value());
     assert_eq!(bodies, Some(3.0));
+    let rescued = store
+        .get(&PhysicsDiagnosticsPlugin::RESCUED)
+        .and_then(|d| d.value());
+    assert_eq!(rescued, Some(1.0));
+    let price = store
+        .get(&PhysicsDiagnosticsPlugin::NUMERICAL_DAMPING)
+        .and_then(|d| d.value())
+        .unwrap();
+    assert!(price.is_finite(), "{price}");
     let ke = store
         .get(&PhysicsDiagnosticsPlugin::KINETIC_ENERGY)
         .and_then(|d| d.value())

@@ -155,3 +155,51 @@ fn a_taut_string_keeps_its_tone_at_the_defaults() {
     );
     assert!(per_period < 0.05, "{per_period}");
 }
+
+/// The stiff-rod pendulum of the first test under a policy, for `seconds`: the energy lost
+/// (J, from the diagnostics' total) and the numerical damping the diagnostics report at the
+/// end (W).
+fn pendulum_price(policy: hooke::integrator::StabilityPolicy, seconds: f32) -> (f64, f64) {
+    let mut w = common::default_world();
+    w.insert_resource(policy);
+    let pin = w.spawn(ParticleBundle::pinned(Vec3::ZERO).unwrap()).id();
+    let bob = w
+        .spawn(ParticleBundle::new(Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO, 1.0).unwrap())
+        .id();
+    Spring::from_hooke(pin, bob, 1.0, 1e6, 0.0)
+        .unwrap()
+        .spawn(&mut w)
+        .unwrap();
+    w.step_physics();
+    let e0 = w.resource::<PhysicsDiagnostics>().total_energy();
+    for _ in 0..(seconds * 60.0) as usize {
+        w.step_physics();
+    }
+    let d = w.resource::<PhysicsDiagnostics>();
+    (e0 - d.total_energy(), d.numerical_damping)
+}
+
+#[test]
+fn the_price_of_the_rescue_is_in_the_diagnostics_and_agrees_with_the_energy_lost() {
+    use hooke::integrator::StabilityPolicy::SwitchToImplicit;
+    let seconds = 4.0 * 2.3678; // four periods
+    let (be_lost, be_rate) =
+        pendulum_price(SwitchToImplicit(ImplicitScheme::BackwardEuler), seconds);
+    let (bdf2_lost, bdf2_rate) = pendulum_price(SwitchToImplicit(ImplicitScheme::Bdf2), seconds);
+    // The pendulum's energy relative to its lowest point is m g L = 9.81 J.
+    println!(
+        "over 4 periods: backward Euler lost {be_lost:.3} J ({:.3} W on average), reported {be_rate:.3} W; BDF2 lost {bdf2_lost:.2e} J, reported {bdf2_rate:.2e} W",
+        be_lost / f64::from(seconds)
+    );
+    // Backward Euler's loss is real and reported at its size (the report averages over the
+    // last second, the loss over four periods: within 50%).
+    assert!(be_lost > 0.5, "{be_lost}");
+    let mean = be_lost / f64::from(seconds);
+    assert!(
+        be_rate > 0.5 * mean && be_rate < 1.5 * mean,
+        "{be_rate} vs {mean}"
+    );
+    // BDF2 keeps the swing: a hundredth of backward Euler's price, in the loss and the report.
+    assert!(bdf2_lost.abs() < 0.01 * be_lost, "{bdf2_lost}");
+    assert!(bdf2_rate.abs() < 0.01 * be_rate, "{bdf2_rate}");
+}
