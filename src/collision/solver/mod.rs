@@ -633,15 +633,20 @@ impl ContactSolver {
     pub fn warm_start(&mut self) {
         self.for_each_batch(|batch, friction, (points, tracks), _, [a, b]| {
             if batch.bouncy() {
-                // The velocity the last pass left stands in for the present one (they differ
-                // by the forces of one substep): the hot loop does not pay for another
-                // relative velocity per point.
+                // The work at the present relative velocity, point by point as the impulses
+                // land: the velocity the last pass left is stale by every impulse other
+                // contacts gave the two bodies after it (in a row of touching balls, most of
+                // the row's), and a budget credited from it let restitution create energy
+                // in some spawn orders.
                 for (p, t) in points.iter().zip(tracks.iter_mut()) {
-                    t.lost -= work(p.n_imp, t.vn_end, t.half_w);
+                    let vn = batch.n.dot(Side::relative(a, b, p.r_a, p.r_b));
+                    t.lost -= work(p.n_imp, vn, t.half_w);
+                    Side::push(a, b, batch.n, &p.normal, p.n_imp);
                 }
-            }
-            for p in points.iter() {
-                Side::push(a, b, batch.n, &p.normal, p.n_imp);
+            } else {
+                for p in points.iter() {
+                    Side::push(a, b, batch.n, &p.normal, p.n_imp);
+                }
             }
             friction.warm_start(batch, a, b);
         });
