@@ -6,12 +6,14 @@ use plotters::prelude::*;
 
 use crate::problems::Problem;
 
-const SERIES: [(&str, RGBColor); 12] = [
+const SERIES: [(&str, RGBColor); 14] = [
     ("explicit_euler", RGBColor(214, 39, 40)),
     ("symplectic_euler", RGBColor(31, 119, 180)),
     ("velocity_verlet", RGBColor(44, 160, 44)),
     ("rk4", RGBColor(148, 103, 189)),
     ("implicit_euler", RGBColor(255, 127, 14)),
+    ("symplectic_euler+bdf2", RGBColor(0, 0, 139)),
+    ("symplectic_euler+backward_euler", RGBColor(255, 187, 120)),
     ("Green", RGBColor(23, 190, 207)),
     ("Cauchy", RGBColor(188, 189, 34)),
     ("Corotated", RGBColor(140, 86, 75)),
@@ -192,6 +194,10 @@ fn legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>) -> DrawResult {
         "SE symplectic Euler,",
         "VV velocity Verlet;",
         "Splitting is the default.",
+        "+bdf2: the default policy",
+        "rescues what is past its",
+        "limit by BDF2 (+backward_",
+        "euler: the old rescue).",
         "Diverged settings are",
         "counted in the panel title.",
     ] {

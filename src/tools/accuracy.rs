@@ -58,7 +58,7 @@ use bevy_ecs::prelude::*;
 use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::error::{Error, Result};
 use crate::core::time::PhysicsTime;
-use crate::integrator::Integrator;
+use crate::integrator::{ImplicitScheme, Integrator, StabilityPolicy};
 use crate::plugins::PhysicsPlugins;
 use crate::plugins::PhysicsWorldExt;
 
@@ -69,18 +69,43 @@ pub struct Setting {
     pub integrator: Integrator,
     /// Substeps per fixed step (≥ 1).
     pub substeps: u32,
+    /// What [`StabilityPolicy`] switches a system past its explicit limit to: None keeps
+    /// every system on `integrator` (`StabilityPolicy::Warn`, the dial as it is), Some(s)
+    /// is the policy `SwitchToImplicit(s)`; the default policy is `Some(Bdf2)`.
+    pub rescue: Option<ImplicitScheme>,
 }
 
 impl Setting {
-    /// hooke's defaults: symplectic Euler with 4 substeps ([`PhysicsTime::default`]).
-    pub const DEFAULT: Setting = Setting::new(Integrator::SymplecticEuler, 4);
+    /// hooke's defaults: symplectic Euler with 4 substeps ([`PhysicsTime::default`]), and the
+    /// default [`StabilityPolicy`] (BDF2 for what is past its limit).
+    pub const DEFAULT: Setting =
+        Setting::new(Integrator::SymplecticEuler, 4).with_rescue(ImplicitScheme::Bdf2);
 
-    /// A setting.
+    /// A setting of the dial: every system stays on `integrator`.
     #[must_use]
     pub const fn new(integrator: Integrator, substeps: u32) -> Self {
         Self {
             integrator,
             substeps,
+            rescue: None,
+        }
+    }
+
+    /// The same setting with the stability policy switching what is past its limit to
+    /// `scheme`.
+    #[must_use]
+    pub const fn with_rescue(mut self, scheme: ImplicitScheme) -> Self {
+        self.rescue = Some(scheme);
+        self
+    }
+
+    /// The series name of the setting: the integrator, or the policy's rescue
+    /// (`policy→bdf2`).
+    #[must_use]
+    pub fn series(&self) -> String {
+        match self.rescue {
+            None => self.integrator.name().to_string(),
+            Some(s) => format!("{}+{}", self.integrator.name(), s.name()),
         }
     }
 
@@ -96,7 +121,7 @@ impl Setting {
 
 impl std::fmt::Display for Setting {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{} ×{}", self.integrator.name(), self.substeps)
+        write!(f, "{} ×{}", self.series(), self.substeps)
     }
 }
 
@@ -241,6 +266,10 @@ pub fn world_for(setting: Setting, dt: f32) -> Result<World> {
     world.insert_resource(PhysicsTime::new(dt, setting.substeps)?);
     world.add_physics(PhysicsPlugins);
     world.insert_resource(setting.integrator);
+    world.insert_resource(match setting.rescue {
+        Some(scheme) => StabilityPolicy::SwitchToImplicit(scheme),
+        None => StabilityPolicy::Warn,
+    });
     Ok(world)
 }
 
