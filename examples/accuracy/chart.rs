@@ -161,12 +161,18 @@ fn legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>) -> DrawResult {
     for (name, c) in SERIES {
         area.draw(&Circle::new((28, y + 7), 5, c.filled()))
             .map_err(err)?;
-        area.draw(&Text::new(name, (42, y), font.clone()))
+        // The policy's series by what they are (their keys name the dial's integrator too).
+        let shown = match name {
+            "symplectic_euler+bdf2" => "rescue: BDF2 (default)",
+            "symplectic_euler+backward_euler" => "rescue: backward Euler",
+            other => other,
+        };
+        area.draw(&Text::new(shown, (42, y), font.clone()))
             .map_err(err)?;
         y += 20;
     }
     // Right column: the lines and how to read the labels.
-    let (x, mut y) = (200, 42);
+    let (x, mut y) = (215, 42);
     area.draw(&PathElement::new(
         vec![(x, y + 7), (x + 18, y + 7)],
         BLACK.stroke_width(2),
@@ -194,10 +200,9 @@ fn legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>) -> DrawResult {
         "SE symplectic Euler,",
         "VV velocity Verlet;",
         "Splitting is the default.",
-        "+bdf2: the default policy",
-        "rescues what is past its",
-        "limit by BDF2 (+backward_",
-        "euler: the old rescue).",
+        "rescue: symplectic Euler,",
+        "what is past its limit",
+        "switched by the policy.",
         "Diverged settings are",
         "counted in the panel title.",
     ] {
