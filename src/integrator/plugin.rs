@@ -46,6 +46,7 @@ impl WorldPlugin for IntegratorPlugin {
     fn build(&self, world: &mut World) {
         crate::core::restore::init::<Integrator>(world);
         crate::core::restore::init::<ConstraintsActive>(world);
+        world.init_resource::<super::stages::Rk4Starts>();
         crate::core::restore::init::<super::StabilityPolicy>(world);
         crate::core::plugin::add_message::<super::StabilityWarning>(world);
         crate::core::restore::init::<super::stability::SharedNumericalDamping>(world);
@@ -244,7 +245,7 @@ type IntegratedBody<'a> = (
     &'a Mass,
 );
 
-#[allow(clippy::type_complexity)] // a ParamSet of queries; naming each adds nothing
+#[allow(clippy::type_complexity, clippy::too_many_arguments)] // a system: one query or resource each
 fn integrate_velocities(
     mut commands: Commands,
     guard: Res<DivergenceGuard>,
@@ -255,11 +256,26 @@ fn integrate_velocities(
         Query<IntegratedBody, (Without<IntegratorOverride>, Simulated)>,
         Query<(IntegratedBody, &IntegratorOverride), Simulated>,
         Suspects,
+        Query<Rk4Body, Simulated>,
     )>,
     mut meshes: Query<(&mut Nodes, Option<&IntegratorOverride>), super::ExplicitMesh>,
+    mut starts: ResMut<super::stages::Rk4Starts>,
 ) {
     let h = time.h;
     let method = *global;
+    starts.0.clear();
+    if method == Integrator::Rk4 || !set.p1().is_empty() {
+        // RK4 bodies kick and drift as symplectic Euler around the constraint solve, so that
+        // contacts see this substep's approach; the stages replace that step by RK4's where
+        // no constraint touched the body (see `stages::complete_stages`).
+        for (e, x, mut v, f, m, o) in &mut set.p3() {
+            if o.map_or(method, |o| o.0) == Integrator::Rk4 {
+                let predicted = kick(v.0, f.0 * m.inverse(), h);
+                starts.0.push((e, x.0, v.0, predicted));
+                v.0 = predicted;
+            }
+        }
+    }
     if constraints.fuses(method) {
         // Both halves of symplectic Euler in one pass; see `ConstraintsActive`.
         let mut probe = Vec3A::ZERO;
@@ -327,6 +343,16 @@ fn body_velocity_phase(
 
 type Drift<'a> = (&'a mut Position, &'a LinearVelocity);
 
+/// What RK4's prediction reads and writes of a body.
+type Rk4Body<'a> = (
+    Entity,
+    &'a Position,
+    &'a mut LinearVelocity,
+    &'a Force,
+    &'a Mass,
+    Option<&'a IntegratorOverride>,
+);
+
 /// Finds the bodies whose state is non-finite; runs only after the fast pass saw one.
 type Suspects<'w, 's> =
     Query<'w, 's, (Entity, &'static Position, &'static LinearVelocity), (With<Mass>, Simulated)>;
@@ -381,7 +407,10 @@ fn integrate_positions(
         // Done in the velocity pass.
     } else if matches!(
         method,
-        Integrator::SymplecticEuler | Integrator::VelocityVerlet | Integrator::ImplicitEuler
+        Integrator::SymplecticEuler
+            | Integrator::VelocityVerlet
+            | Integrator::ImplicitEuler
+            | Integrator::Rk4
     ) {
         bodies.p0().iter_mut().for_each(|(mut x, v)| {
             let (xa, va) = (x.0, v.0);
@@ -399,7 +428,10 @@ fn integrate_positions(
     bodies.p1().iter_mut().for_each(|((mut x, v), o)| {
         if matches!(
             o.0,
-            Integrator::SymplecticEuler | Integrator::VelocityVerlet | Integrator::ImplicitEuler
+            Integrator::SymplecticEuler
+                | Integrator::VelocityVerlet
+                | Integrator::ImplicitEuler
+                | Integrator::Rk4
         ) {
             x.0 = drift(x.0, v.0, h);
         }

@@ -108,6 +108,11 @@ impl AngularRk4 {
     }
 }
 
+/// Each RK4 body's (x₀, v₀) at the substep's start and the symplectic velocity it was
+/// given for the constraint solve (written by the velocity phase).
+#[derive(Resource, Debug, Default)]
+pub(crate) struct Rk4Starts(pub Vec<(Entity, Vec3A, Vec3A, Vec3A)>);
+
 /// Reused allocations of [`complete_stages`].
 #[derive(Default)]
 pub(crate) struct StageScratch {
@@ -155,10 +160,27 @@ pub(crate) fn complete_stages(
     s.rotations.clear();
     s.verlet_rotations.clear();
 
-    // Stage 1: RK4 bodies still sit at their start state with forces evaluated there.
+    // Stage 1. An RK4 body was kicked and drifted as symplectic Euler for the constraint
+    // solve: one that no constraint touched (its state is the prediction, bit for bit) goes
+    // back to its start state for RK4's stages; one a contact touched keeps the symplectic
+    // step with the contact in it (RK4's stages would integrate this substep's gravity past
+    // the contact that holds it: a resting ball sank through its box).
+    let starts: std::collections::HashMap<Entity, (Vec3A, Vec3A, Vec3A)> = world
+        .resource::<Rk4Starts>()
+        .0
+        .iter()
+        .map(|&(e, x0, v0, vp)| (e, (x0, v0, vp)))
+        .collect();
     for (e, mut x, mut v, f, m, o) in bodies.iter_mut(world) {
         match o.map_or(global, |o| o.0) {
             Integrator::Rk4 => {
+                if let Some(&(x0, v0, predicted)) = starts.get(&e) {
+                    let untouched = v.0 == predicted && x.0 == super::drift(x0, predicted, h);
+                    if !untouched {
+                        continue;
+                    }
+                    (x.0, v.0) = (x0, v0);
+                }
                 let mut r = Rk4Scratch::begin(x.0, v.0);
                 (x.0, v.0) = r.stage(0, v.0, f.0 * m.inverse(), h);
                 s.bodies.push((e, r));
