@@ -407,6 +407,7 @@ fn main() {
     }
     if run("springs") {
         springs::implicit_springs(&cfg);
+        springs::rescue_costs(&cfg);
         springs::cloth_vs_rapier(&cfg, if quick { 120 } else { 600 });
     }
     if run("scenario") {

@@ -187,3 +187,110 @@ pub fn cloth_vs_rapier(cfg: &Config, steps: usize) {
         );
     }
 }
+
+/// One case of the stability policy's price: `spawn` builds the scene; it runs at the
+/// defaults (60 Hz × 4, the policy switching what is past its limit to `scheme`) against
+/// explicit symplectic Euler at the substeps the policy's warning says the scene needs
+/// (`StabilityPolicy::Warn`), each after 30 warm-up steps.
+fn rescue_case(
+    cfg: &Config,
+    name: &str,
+    scheme: hooke::integrator::ImplicitScheme,
+    spawn: impl Fn(&mut World),
+) {
+    use hooke::integrator::StabilityPolicy;
+    let mut rescued = world(4);
+    rescued.insert_resource(StabilityPolicy::SwitchToImplicit(scheme));
+    spawn(&mut rescued);
+    rescued.step_physics();
+    let needed = {
+        let m =
+            rescued.resource::<bevy_ecs::message::Messages<hooke::integrator::StabilityWarning>>();
+        m.get_cursor()
+            .read(m)
+            .map(|w| w.substeps_needed)
+            .max()
+            .unwrap_or(4)
+    };
+    let mut explicit = world(needed);
+    explicit.insert_resource(StabilityPolicy::Warn);
+    spawn(&mut explicit);
+    for _ in 0..30 {
+        rescued.step_physics();
+        explicit.step_physics();
+    }
+    let (ours, reference) = compare(cfg, || rescued.step_physics(), || explicit.step_physics());
+    line(
+        name,
+        ours,
+        reference,
+        &format!(
+            "defaults ({} past the limit) vs symplectic x{needed} (the substeps it needs)",
+            scheme.name()
+        ),
+    );
+}
+
+/// What the stability policy's rescue costs against explicit integration at the substeps
+/// that would keep each case explicit: the stiff-rod pendulum and the stiff rope of the
+/// tests, and a soft bar of E = 1e6 Pa (480 tets).
+pub fn rescue_costs(cfg: &Config) {
+    use hooke::integrator::ImplicitScheme;
+    for scheme in [ImplicitScheme::Bdf2, ImplicitScheme::BackwardEuler] {
+        let tag = scheme.name();
+        rescue_case(
+            cfg,
+            &format!("rescue_pendulum_{tag}_vs_symplectic_needed"),
+            scheme,
+            |w| {
+                let pin = w.spawn(ParticleBundle::pinned(Vec3::ZERO).unwrap()).id();
+                let bob = w
+                    .spawn(ParticleBundle::new(Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO, 1.0).unwrap())
+                    .id();
+                Spring::from_hooke(pin, bob, 1.0, 1e6, 0.0)
+                    .unwrap()
+                    .spawn(w)
+                    .unwrap();
+            },
+        );
+        rescue_case(
+            cfg,
+            &format!("rescue_rope20_{tag}_vs_symplectic_needed"),
+            scheme,
+            |w| {
+                hooke::springs::ChainBuilder::rope(
+                    Vec3::new(0.0, 2.0, 0.0),
+                    Vec3::new(1.0, 2.0, 0.0),
+                    20,
+                )
+                .stiffness(20.0 * 0.1 * 9.81 / (1e-3 / 19.0))
+                .spawn(w)
+                .unwrap();
+            },
+        );
+        rescue_case(
+            cfg,
+            &format!("rescue_softbar480_{tag}_vs_symplectic_needed"),
+            scheme,
+            |w| {
+                use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+                let mesh =
+                    TetMesh::cuboid(Vec3::new(0.1, 1.0, 0.1), [2, 20, 2], CellSplit::Six).unwrap();
+                let material = Material::new(1e6, 0.3, 1000.0).unwrap();
+                let (mut nodes, body) = SoftBody::build(
+                    &mesh,
+                    Vec3::new(0.0, -0.5, 0.0),
+                    material,
+                    StrainModel::Corotated,
+                )
+                .unwrap();
+                for i in 0..nodes.len() {
+                    if nodes.positions()[i].y.abs() < 1e-5 {
+                        nodes.pin(i).unwrap();
+                    }
+                }
+                w.spawn((nodes, body));
+            },
+        );
+    }
+}
