@@ -243,14 +243,7 @@ pub fn rescue_costs(cfg: &Config) {
             &format!("rescue_pendulum_{tag}_vs_symplectic_needed"),
             scheme,
             |w| {
-                let pin = w.spawn(ParticleBundle::pinned(Vec3::ZERO).unwrap()).id();
-                let bob = w
-                    .spawn(ParticleBundle::new(Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO, 1.0).unwrap())
-                    .id();
-                Spring::from_hooke(pin, bob, 1.0, 1e6, 0.0)
-                    .unwrap()
-                    .spawn(w)
-                    .unwrap();
+                hooke::tools::scenes::stiff_rod_pendulum(w, 1e6).unwrap();
             },
         );
         rescue_case(

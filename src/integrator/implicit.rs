@@ -339,6 +339,7 @@ pub(crate) fn step<E: ImplicitElements>(
     state: &mut ImplicitState,
     h: f32,
     s: &mut Scratch<E>,
+    account: bool,
 ) -> Option<ImplicitReport> {
     let len = n.x.len();
     // BDF2 with a history from the same step: the backward-Euler potential about
@@ -409,9 +410,14 @@ pub(crate) fn step<E: ImplicitElements>(
     s.hess.resize(count, E::zero());
     s.raw.resize(count, E::zero());
     s.negative.resize(count, false);
-    // The energy at the start (kinetic and elastic), for the numerical damping's account.
-    let mut energy_before = body.prepare(&s.x0, &mut s.prep_trial);
-    for i in 0..len {
+    // The energy at the start (kinetic and elastic), for the numerical damping's account: an
+    // element pass more per substep, made only while the energy diagnostics are on.
+    let mut energy_before = if account {
+        body.prepare(&s.x0, &mut s.prep_trial)
+    } else {
+        0.0
+    };
+    for i in (0..len).filter(|_| account) {
         if n.inv_mass[i] != 0.0 {
             energy_before += 0.5 * f64::from(n.mass[i]) * d3(n.v[i]).length_squared();
         }
@@ -674,6 +680,40 @@ pub(crate) fn step<E: ImplicitElements>(
             Vec3::ZERO
         };
     }
+    if account {
+        account_numerical_damping(
+            body,
+            n,
+            s,
+            state,
+            &free,
+            (h, alpha),
+            energy_before,
+            elastic_now,
+        );
+    } else {
+        state.numerical_damping = 0.0;
+    }
+    s.free = free;
+    // Stats at the end state, whose elements the last accepted trial prepared.
+    body.finish(&s.prep, elastic_now);
+    (elastic_now.is_finite() && n.x.iter().all(|x| x.is_finite())).then_some(report)
+}
+
+/// The energy the scheme took this substep beyond the model's damping, into the state's
+/// average (see [`super::ImplicitState::numerical_damping`]).
+#[allow(clippy::too_many_arguments)] // the solve's end state, passed once per substep
+fn account_numerical_damping<E: ImplicitElements>(
+    body: &E,
+    n: &Nodes,
+    s: &mut Scratch<E>,
+    state: &mut ImplicitState,
+    free: &[bool],
+    (h, alpha): (f32, f64),
+    energy_before: f64,
+    elastic_now: f64,
+) {
+    let len = n.x.len();
     // What the scheme took: the start's energy and the constant forces' work, less the
     // model's own damping (α M and the elements' D, at the new velocity) and the end's energy.
     let (mut work, mut energy_after, mut damped) = (0.0f64, elastic_now, 0.0f64);
@@ -705,10 +745,6 @@ pub(crate) fn step<E: ImplicitElements>(
         let now = f64::from(state.numerical_damping);
         state.numerical_damping = (now + (rate - now) * weight) as f32;
     }
-    s.free = free;
-    // Stats at the end state, whose elements the last accepted trial prepared.
-    body.finish(&s.prep, elastic_now);
-    (elastic_now.is_finite() && n.x.iter().all(|x| x.is_finite())).then_some(report)
 }
 
 /// CG on H dx = −g with the element matrices `hess` (and D from `s.hess0`, K₀'s); false if it met

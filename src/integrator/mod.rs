@@ -276,7 +276,8 @@ impl ImplicitState {
     /// elastic energy plus the work of the step's constant forces (gravity, external), less
     /// the model's damping and the end's energy. Backward Euler on an oscillator of energy E
     /// and frequency ω takes about E ω² h; BDF2 orders of magnitude less at ωh ≪ 1. What a
-    /// contact held in the solve takes counts too.
+    /// contact held in the solve takes counts too. Zero while the energy diagnostics are off
+    /// (`DiagnosticsSettings::energy`): the account costs an element pass per substep.
     #[must_use]
     pub fn numerical_damping(&self) -> f32 {
         self.numerical_damping
@@ -297,11 +298,11 @@ impl Default for ImplicitEuler {
 }
 
 impl ImplicitEuler {
-    /// The default settings solved by [`ImplicitScheme::Bdf2`].
+    /// The default settings, solved by `scheme`.
     #[must_use]
-    pub fn bdf2() -> Self {
+    pub fn solved_by(scheme: ImplicitScheme) -> Self {
         Self {
-            scheme: ImplicitScheme::Bdf2,
+            scheme,
             ..Self::default()
         }
     }

@@ -100,6 +100,29 @@ impl StabilityWarning {
     }
 }
 
+/// Tells that a system is past its limit, once: the [`StabilityWarning`] (with the substeps
+/// a step of `dt` would need) and the diagnostics' counts.
+pub(crate) fn tell(
+    warnings: &mut MessageWriter<StabilityWarning>,
+    diag: Option<&mut crate::core::diagnostics::PhysicsDiagnostics>,
+    entity: Entity,
+    critical_step: f32,
+    (dt, substep): (f32, f32),
+    rescue: Option<ImplicitScheme>,
+) {
+    warnings.write(StabilityWarning {
+        entity,
+        critical_step,
+        substep,
+        substeps_needed: substeps_needed(dt, critical_step),
+        rescue,
+    });
+    if let Some(d) = diag {
+        d.stability_warnings += 1;
+        d.rescued += u64::from(rescue.is_some());
+    }
+}
+
 /// The explicit limit h_crit (s) of a node whose stiffness row sum is `k` (1/s², a bound on
 /// ω²) and damping row sum `c` (1/s, a bound on 2ζω); infinite when both are zero. See the
 /// module docs.

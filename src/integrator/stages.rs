@@ -122,6 +122,8 @@ pub(crate) struct StageScratch {
     /// RK4 rotations: entity, scratch and the un-normalised stage quaternion.
     rotations: Vec<(Entity, AngularRk4, Quat)>,
     verlet_rotations: Vec<Entity>,
+    /// [`Rk4Starts`] by entity.
+    starts: std::collections::HashMap<Entity, (Vec3A, Vec3A, Vec3A)>,
 }
 
 type StageBody<'a> = (
@@ -165,16 +167,18 @@ pub(crate) fn complete_stages(
     // back to its start state for RK4's stages; one a contact touched keeps the symplectic
     // step with the contact in it (RK4's stages would integrate this substep's gravity past
     // the contact that holds it: a resting ball sank through its box).
-    let starts: std::collections::HashMap<Entity, (Vec3A, Vec3A, Vec3A)> = world
-        .resource::<Rk4Starts>()
-        .0
-        .iter()
-        .map(|&(e, x0, v0, vp)| (e, (x0, v0, vp)))
-        .collect();
+    s.starts.clear();
+    s.starts.extend(
+        world
+            .resource::<Rk4Starts>()
+            .0
+            .iter()
+            .map(|&(e, x0, v0, vp)| (e, (x0, v0, vp))),
+    );
     for (e, mut x, mut v, f, m, o) in bodies.iter_mut(world) {
         match o.map_or(global, |o| o.0) {
             Integrator::Rk4 => {
-                if let Some(&(x0, v0, predicted)) = starts.get(&e) {
+                if let Some(&(x0, v0, predicted)) = s.starts.get(&e) {
                     let untouched = v.0 == predicted && x.0 == super::drift(x0, predicted, h);
                     if !untouched {
                         continue;

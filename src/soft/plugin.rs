@@ -111,7 +111,9 @@ fn solve_implicit(
         Simulated,
     >,
     mut scratch: Local<crate::integrator::implicit::Scratch<SoftBody>>,
+    diagnostics: Option<Res<crate::core::diagnostics::DiagnosticsSettings>>,
 ) {
+    let account = diagnostics.is_none_or(|d| d.energy);
     for (e, mut nodes, mut body, settings, mut state) in &mut bodies {
         if nodes.is_changed() {
             // Moved from outside the step (spawned, teleported): no history to extrapolate.
@@ -125,6 +127,7 @@ fn solve_implicit(
             state.bypass_change_detection(),
             time.h,
             &mut scratch,
+            account,
         ) {
             Some(report) => {
                 body.stats.implicit = report;

@@ -24,9 +24,7 @@ use super::SoftBody;
 use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::quarantine::Quarantined;
 use crate::core::time::PhysicsTime;
-use crate::integrator::stability::{
-    StabilityPolicy, StabilityWarning, critical_step, substeps_needed,
-};
+use crate::integrator::stability::{StabilityPolicy, StabilityWarning, critical_step, tell};
 use crate::integrator::{ImplicitEuler, Integrator, IntegratorOverride};
 
 /// A soft body's explicit stability limit (see the module docs); added with [`SoftBody`].
@@ -100,22 +98,16 @@ pub(crate) fn check_soft_stability(
         stability.warned = true;
         let rescue = policy.rescue(method);
         if let Some(scheme) = rescue {
-            commands.entity(e).insert(ImplicitEuler {
-                scheme,
-                ..ImplicitEuler::default()
-            });
+            commands.entity(e).insert(ImplicitEuler::solved_by(scheme));
         }
-        warnings.write(StabilityWarning {
-            entity: e,
-            critical_step: stability.critical_step,
-            substep,
-            substeps_needed: substeps_needed(time.dt(), stability.critical_step),
+        tell(
+            &mut warnings,
+            diag.as_deref_mut(),
+            e,
+            stability.critical_step,
+            (time.dt(), substep),
             rescue,
-        });
-        if let Some(d) = diag.as_mut() {
-            d.stability_warnings += 1;
-            d.rescued += u64::from(rescue.is_some());
-        }
+        );
     }
     if let Some(d) = diag.as_mut() {
         d.soft_critical_step = smallest;

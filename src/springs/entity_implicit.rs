@@ -156,6 +156,16 @@ impl EntitySolve {
     }
 }
 
+/// The solve's other inputs: the spring order's storage, where its numerical damping goes,
+/// and whether the energy diagnostics want it.
+type SolveContext<'w, 's> = (
+    &'w bevy_ecs::archetype::Archetypes,
+    bevy_ecs::component::ComponentIdFor<'s, Spring>,
+    Local<'s, Vec<Entity>>,
+    ResMut<'w, crate::integrator::stability::SharedNumericalDamping>,
+    Option<Res<'w, crate::core::diagnostics::DiagnosticsSettings>>,
+);
+
 /// Solves every implicit entity spring of the world in one backward-Euler step and hands the
 /// resulting forces to the ends (see the module docs).
 #[allow(clippy::too_many_arguments)] // a system: each argument is one query or resource it reads
@@ -171,12 +181,7 @@ pub(crate) fn solve_entity_springs(
     mut torques: Query<&mut Torque, Without<Quarantined>>,
     mut solve: Local<EntitySolve>,
     mut kept: ResMut<EntitySpringFactor>,
-    (archetypes, spring_id, mut order, mut shared): (
-        &bevy_ecs::archetype::Archetypes,
-        bevy_ecs::component::ComponentIdFor<Spring>,
-        Local<Vec<Entity>>,
-        ResMut<crate::integrator::stability::SharedNumericalDamping>,
-    ),
+    (archetypes, spring_id, mut order, mut shared, diagnostics): SolveContext,
 ) {
     let kept = &mut *kept;
     let global = *global;
@@ -299,6 +304,7 @@ pub(crate) fn solve_entity_springs(
         &mut kept.state,
         h,
         &mut s.scratch,
+        diagnostics.is_none_or(|d| d.energy),
     );
     let failure = match report {
         None => Some((QuarantineReason::NonFiniteState, None)),

@@ -185,7 +185,9 @@ pub(crate) fn solve_implicit_springs(
         Without<Quarantined>,
     >,
     mut scratch: Local<Scratch<SpringNetwork>>,
+    diagnostics: Option<Res<crate::core::diagnostics::DiagnosticsSettings>>,
 ) {
+    let account = diagnostics.is_none_or(|d| d.energy);
     for (e, mut nodes, mut network, settings, mut state) in &mut meshes {
         if nodes.is_changed() {
             // Moved from outside the step (spawned, teleported): no history to extrapolate.
@@ -212,6 +214,7 @@ pub(crate) fn solve_implicit_springs(
             state.bypass_change_detection(),
             time.h,
             &mut scratch,
+            account,
         );
         let reason = match report {
             None => Some(QuarantineReason::NonFiniteState),

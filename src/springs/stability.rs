@@ -30,9 +30,7 @@ use bevy_ecs::prelude::*;
 use super::{Spring, SpringNetwork};
 use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::time::PhysicsTime;
-use crate::integrator::stability::{
-    StabilityPolicy, StabilityWarning, critical_step, substeps_needed,
-};
+use crate::integrator::stability::{StabilityPolicy, StabilityWarning, critical_step, tell};
 use crate::integrator::{ImplicitEuler, ImplicitScheme, Integrator, IntegratorOverride};
 use crate::particles::{Mass, Nodes};
 
@@ -130,19 +128,16 @@ pub(crate) fn check_stability(
     let mut smallest = f32::INFINITY;
     let mut warn = |entity: Entity,
                     h_crit: f32,
-                    rescue: Option<crate::integrator::ImplicitScheme>,
+                    rescue: Option<ImplicitScheme>,
                     diag: &mut Option<ResMut<PhysicsDiagnostics>>| {
-        warnings.write(StabilityWarning {
+        tell(
+            &mut warnings,
+            diag.as_deref_mut(),
             entity,
-            critical_step: h_crit,
-            substep,
-            substeps_needed: substeps_needed(time.dt(), h_crit),
+            h_crit,
+            (time.dt(), substep),
             rescue,
-        });
-        if let Some(d) = diag {
-            d.stability_warnings += 1;
-            d.rescued += u64::from(rescue.is_some());
-        }
+        );
     };
     let implicit_dial = global == Integrator::ImplicitEuler;
     for (e, nodes, network, mut stability, implicit, o) in &mut meshes {
@@ -155,10 +150,7 @@ pub(crate) fn check_stability(
             stability.warned = true;
             let rescue = policy.rescue(o.map_or(global, |o| o.0));
             if let Some(scheme) = rescue {
-                commands.entity(e).insert(ImplicitEuler {
-                    scheme,
-                    ..ImplicitEuler::default()
-                });
+                commands.entity(e).insert(ImplicitEuler::solved_by(scheme));
             }
             warn(e, stability.critical_step, rescue, &mut diag);
         }
@@ -255,10 +247,7 @@ pub(crate) fn check_stability(
         }
         if let Some(scheme) = rescue {
             for e in stiff {
-                commands.entity(e).insert(ImplicitEuler {
-                    scheme,
-                    ..ImplicitEuler::default()
-                });
+                commands.entity(e).insert(ImplicitEuler::solved_by(scheme));
             }
         }
     }

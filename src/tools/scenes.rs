@@ -530,6 +530,25 @@ pub fn pinned_beam(
     Ok((nodes, body))
 }
 
+/// A 1 kg particle on a 1 m spring of stiffness `k` (N/m) from a pin at the origin, released
+/// from rest level with it (at 90°): a pendulum on a rod as stiff as `k`. At 1e6 N/m the rod's
+/// own mode is 1000 rad/s, past the default substep's explicit limit. Returns the bob.
+///
+/// # Errors
+/// As [`Spring::from_hooke`] for a bad `k`.
+pub fn stiff_rod_pendulum(world: &mut World, k: f32) -> Result<Entity> {
+    let pin = world.spawn(ParticleBundle::pinned(Vec3::ZERO)?).id();
+    let bob = world
+        .spawn(ParticleBundle::new(
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::ZERO,
+            1.0,
+        )?)
+        .id();
+    Spring::from_hooke(pin, bob, 1.0, k, 0.0)?.spawn(world)?;
+    Ok(bob)
+}
+
 /// The catenary parameter a (m) of a chain of `length` hung between two pins `span` apart
 /// at one height: the root of L = 2a sinh(S / 2a), by bisection (the right side falls as a
 /// grows). Its sag is a (cosh(S / 2a) − 1), its support tension w a cosh(S / 2a).

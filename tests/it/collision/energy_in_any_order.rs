@@ -10,8 +10,20 @@ use hooke::prelude::*;
 /// The cradle: balls 0..count touching along x, the striker (index `count`) at 3 m/s from
 /// the left; spawned in `order` (a permutation of 0..=count). Returns (energy after /
 /// before, the most energy ever above the start over the start, momentum after / before).
-fn cradle(count: usize, order: &[usize], e: f32, mu: f32) -> (f64, f64, f64) {
-    let mut w = common::awake_world(1.0 / 60.0, 4, Vec3::ZERO);
+/// At the defaults (`PhysicsPlugins` alone, gravity off), or at `time` (step, substeps).
+fn cradle(
+    count: usize,
+    order: &[usize],
+    e: f32,
+    mu: f32,
+    time: Option<(f32, u32)>,
+) -> (f64, f64, f64) {
+    let mut w = common::default_world();
+    w.insert_resource(Gravity::new(Vec3::ZERO).unwrap());
+    if let Some((dt, substeps)) = time {
+        w.insert_resource(hooke::core::time::PhysicsTime::new(dt, substeps).unwrap());
+    }
+    let steps = time.map_or(120, |(dt, _)| (2.0 / dt) as usize);
     for &i in order {
         let (x, v) = if i == count {
             (-0.6, 3.0)
@@ -31,7 +43,7 @@ fn cradle(count: usize, order: &[usize], e: f32, mu: f32) -> (f64, f64, f64) {
     let d = w.resource::<PhysicsDiagnostics>();
     let (k0, p0) = (d.kinetic_energy, d.linear_momentum.x);
     let mut worst = f64::NEG_INFINITY;
-    for _ in 0..120 {
+    for _ in 0..steps {
         w.step_physics();
         worst = worst.max(w.resource::<PhysicsDiagnostics>().kinetic_energy / k0 - 1.0);
     }
@@ -64,7 +76,7 @@ fn a_cradle_never_gains_energy_in_any_spawn_order() {
     let (mut low, mut high, mut worst_gain) = (f64::INFINITY, 0.0f64, f64::NEG_INFINITY);
     let orders = permutations(count + 1);
     for order in &orders {
-        let (ratio, gain, momentum) = cradle(count, order, 1.0, 0.0);
+        let (ratio, gain, momentum) = cradle(count, order, 1.0, 0.0, None);
         low = low.min(ratio);
         high = high.max(ratio);
         worst_gain = worst_gain.max(gain);
@@ -81,6 +93,20 @@ fn a_cradle_never_gains_energy_in_any_spawn_order() {
         "{} spawn orders of a 5-ball cradle: energy after x{low:.3} to x{high:.3}, never more than {worst_gain:.1e} above the start",
         orders.len()
     );
+    // Every fifth order again at other frame rates and substeps, with friction.
+    for time in [(1.0 / 30.0, 1), (1.0 / 60.0, 8), (1.0 / 144.0, 2)] {
+        for order in orders.iter().step_by(5) {
+            let (ratio, gain, momentum) = cradle(count, order, 1.0, 0.5, Some(time));
+            assert!(
+                (momentum - 1.0).abs() < 1e-4,
+                "{time:?} {order:?}: momentum x{momentum}"
+            );
+            assert!(
+                gain < 1e-4,
+                "{time:?} {order:?}: energy x{ratio}, {gain:.3e} above"
+            );
+        }
+    }
 }
 
 /// A marker that puts a body in another archetype.

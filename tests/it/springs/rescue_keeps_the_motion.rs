@@ -12,6 +12,7 @@ use glam::Vec3;
 use hooke::integrator::{ImplicitScheme, StabilityWarning};
 use hooke::prelude::*;
 use hooke::springs::ChainBuilder;
+use hooke::tools::scenes;
 
 fn told(w: &World) -> Vec<StabilityWarning> {
     let m = w.resource::<Messages<StabilityWarning>>();
@@ -32,14 +33,7 @@ fn a_pendulum_on_a_stiff_rod_keeps_its_period_and_swing_at_the_defaults() {
     // 1 kg on a 1 m spring of 1e6 N/m: the rod's own mode is 1000 rad/s, h_crit = 2 ms, past
     // the default 1/240 s substep. Released from rest at 90°.
     let mut w = common::default_world();
-    let pin = w.spawn(ParticleBundle::pinned(Vec3::ZERO).unwrap()).id();
-    let bob = w
-        .spawn(ParticleBundle::new(Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO, 1.0).unwrap())
-        .id();
-    Spring::from_hooke(pin, bob, 1.0, 1e6, 0.0)
-        .unwrap()
-        .spawn(&mut w)
-        .unwrap();
+    let bob = scenes::stiff_rod_pendulum(&mut w, 1e6).unwrap();
     let g = 9.81f64;
     // 4 √(L/g) K(sin²(θ₀/2)) at θ₀ = 90°.
     let period = 4.0 * (1.0 / g).sqrt() * elliptic_k(0.5);
@@ -162,14 +156,7 @@ fn a_taut_string_keeps_its_tone_at_the_defaults() {
 fn pendulum_price(policy: hooke::integrator::StabilityPolicy, seconds: f32) -> (f64, f64) {
     let mut w = common::default_world();
     w.insert_resource(policy);
-    let pin = w.spawn(ParticleBundle::pinned(Vec3::ZERO).unwrap()).id();
-    let bob = w
-        .spawn(ParticleBundle::new(Vec3::new(1.0, 0.0, 0.0), Vec3::ZERO, 1.0).unwrap())
-        .id();
-    Spring::from_hooke(pin, bob, 1.0, 1e6, 0.0)
-        .unwrap()
-        .spawn(&mut w)
-        .unwrap();
+    scenes::stiff_rod_pendulum(&mut w, 1e6).unwrap();
     w.step_physics();
     let e0 = w.resource::<PhysicsDiagnostics>().total_energy();
     for _ in 0..(seconds * 60.0) as usize {
