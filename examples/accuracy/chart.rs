@@ -6,12 +6,13 @@ use plotters::prelude::*;
 
 use crate::problems::Problem;
 
-const SERIES: [(&str, RGBColor); 14] = [
+const SERIES: [(&str, RGBColor); 15] = [
     ("explicit_euler", RGBColor(214, 39, 40)),
     ("symplectic_euler", RGBColor(31, 119, 180)),
     ("velocity_verlet", RGBColor(44, 160, 44)),
     ("rk4", RGBColor(148, 103, 189)),
     ("implicit_euler", RGBColor(255, 127, 14)),
+    ("symplectic_euler+automatic", RGBColor(220, 20, 60)),
     ("symplectic_euler+bdf2", RGBColor(0, 0, 139)),
     ("symplectic_euler+backward_euler", RGBColor(255, 187, 120)),
     ("Green", RGBColor(23, 190, 207)),
@@ -163,7 +164,8 @@ fn legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>) -> DrawResult {
             .map_err(err)?;
         // The policy's series by what they are (their keys name the dial's integrator too).
         let shown = match name {
-            "symplectic_euler+bdf2" => "rescue: BDF2 (default)",
+            "symplectic_euler+automatic" => "rescue: automatic (default)",
+            "symplectic_euler+bdf2" => "rescue: BDF2",
             "symplectic_euler+backward_euler" => "rescue: backward Euler",
             other => other,
         };
@@ -202,7 +204,9 @@ fn legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>) -> DrawResult {
         "Splitting is the default.",
         "rescue: symplectic Euler,",
         "what is past its limit",
-        "switched by the policy.",
+        "rescued by the policy;",
+        "automatic: local substeps",
+        "or BDF2, the cheaper.",
         "Diverged settings are",
         "counted in the panel title.",
     ] {

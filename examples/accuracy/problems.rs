@@ -6,7 +6,7 @@ use hooke::collision::Collider;
 use hooke::collision::Friction;
 use hooke::collision::Restitution;
 use hooke::core::schedule::{ForceSystems, add_force_systems};
-use hooke::integrator::ImplicitScheme;
+use hooke::integrator::{ImplicitScheme, StabilityPolicy};
 use hooke::prelude::*;
 use hooke::rigid::Inertia;
 use hooke::rigid::MassProperties;
@@ -90,10 +90,17 @@ pub fn settings() -> Vec<Setting> {
     s
 }
 
-/// [`settings`] and, for scenes with systems past their explicit limit, the stability
-/// policy's rescues at every substep count: BDF2 (the default) and backward Euler.
+/// [`settings`] and, for scenes with systems past their explicit limit, every stability
+/// policy at every substep count: the default's own choice (local substeps or BDF2), BDF2
+/// and backward Euler.
 pub fn stiff_settings() -> Vec<Setting> {
     let mut s = Setting::grid(&Integrator::ALL, &[1, 2, 4, 8]);
+    for substeps in [1, 2, 4, 8] {
+        s.push(
+            Setting::new(Integrator::SymplecticEuler, substeps)
+                .with_policy(StabilityPolicy::Automatic),
+        );
+    }
     for scheme in [ImplicitScheme::Bdf2, ImplicitScheme::BackwardEuler] {
         for substeps in [1, 2, 4, 8] {
             s.push(Setting::new(Integrator::SymplecticEuler, substeps).with_rescue(scheme));
@@ -108,7 +115,7 @@ fn runs(quick: bool) -> u32 {
 
 /// The world every problem starts from: gravity `g`, sleeping off (a resting body would stop
 /// being measured). The setting says whether the stability policy may switch a stiff system
-/// (see `Setting::rescue`).
+/// (see `Setting::policy`).
 fn base(world: &mut World, g: Vec3) -> hooke::Result<()> {
     world.insert_resource(Gravity::new(g)?);
     world.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;

@@ -189,28 +189,31 @@ pub fn cloth_vs_rapier(cfg: &Config, steps: usize) {
 }
 
 /// One case of the stability policy's price: `spawn` builds the scene; it runs at the
-/// defaults (60 Hz × 4, the policy switching what is past its limit to `scheme`) against
-/// explicit symplectic Euler at the substeps the policy's warning says the scene needs
-/// (`StabilityPolicy::Warn`), each after 30 warm-up steps.
+/// defaults (60 Hz × 4) under `policy` against explicit symplectic Euler at the substeps the
+/// policy's warning says the scene needs (`StabilityPolicy::Warn`), each after 30 warm-up
+/// steps.
 fn rescue_case(
     cfg: &Config,
     name: &str,
-    scheme: hooke::integrator::ImplicitScheme,
+    policy: hooke::integrator::StabilityPolicy,
     spawn: impl Fn(&mut World),
 ) {
     use hooke::integrator::StabilityPolicy;
     let mut rescued = world(4);
-    rescued.insert_resource(StabilityPolicy::SwitchToImplicit(scheme));
+    rescued.insert_resource(policy);
     spawn(&mut rescued);
     rescued.step_physics();
-    let needed = {
+    let (needed, chosen) = {
         let m =
             rescued.resource::<bevy_ecs::message::Messages<hooke::integrator::StabilityWarning>>();
-        m.get_cursor()
-            .read(m)
-            .map(|w| w.substeps_needed)
-            .max()
-            .unwrap_or(4)
+        let told: Vec<_> = m.get_cursor().read(m).cloned().collect();
+        let needed = told.iter().map(|w| w.substeps_needed).max().unwrap_or(4);
+        let chosen = match told.first().and_then(|w| w.rescue) {
+            Some(hooke::integrator::Rescue::LocalSubsteps(n)) => format!("{n} local substeps"),
+            Some(r) => r.name().to_string(),
+            None => "nothing".into(),
+        };
+        (needed, chosen)
     };
     let mut explicit = world(needed);
     explicit.insert_resource(StabilityPolicy::Warn);
@@ -225,23 +228,60 @@ fn rescue_case(
         ours,
         reference,
         &format!(
-            "defaults ({} past the limit) vs symplectic x{needed} (the substeps it needs)",
-            scheme.name()
+            "defaults under {policy:?} ({chosen} past the limit) vs symplectic x{needed} (the substeps it needs)"
         ),
     );
 }
 
+/// The stiff rope of the tests: 20 beads of 0.1 kg, its top segment stretched 0.1 % by the
+/// weight below (k = 3.7e5 N/m; 36 substeps at 60 Hz keep it explicit).
+fn stiff_rope20(w: &mut World) {
+    hooke::springs::ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(1.0, 2.0, 0.0), 20)
+        .stiffness(20.0 * 0.1 * 9.81 / (1e-3 / 19.0))
+        .spawn(w)
+        .unwrap();
+}
+
+/// A soft bar of E = 1e6 Pa, 1 m long, 480 tets, hanging from pins.
+fn soft_bar480(w: &mut World) {
+    use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
+    let mesh = TetMesh::cuboid(Vec3::new(0.1, 1.0, 0.1), [2, 20, 2], CellSplit::Six).unwrap();
+    let material = Material::new(1e6, 0.3, 1000.0).unwrap();
+    let (mut nodes, body) = SoftBody::build(
+        &mesh,
+        Vec3::new(0.0, -0.5, 0.0),
+        material,
+        StrainModel::Corotated,
+    )
+    .unwrap();
+    for i in 0..nodes.len() {
+        if nodes.positions()[i].y.abs() < 1e-5 {
+            nodes.pin(i).unwrap();
+        }
+    }
+    w.spawn((nodes, body));
+}
+
 /// What the stability policy's rescue costs against explicit integration at the substeps
 /// that would keep each case explicit: the stiff-rod pendulum and the stiff rope of the
-/// tests, and a soft bar of E = 1e6 Pa (480 tets).
+/// tests, and a soft bar of E = 1e6 Pa (480 tets); under the default policy (its own
+/// choice), BDF2 and backward Euler. Then where local substeps stop being cheaper than BDF2:
+/// the rope stepped n times per substep on its own against the rope under BDF2.
 pub fn rescue_costs(cfg: &Config) {
-    use hooke::integrator::ImplicitScheme;
-    for scheme in [ImplicitScheme::Bdf2, ImplicitScheme::BackwardEuler] {
-        let tag = scheme.name();
+    use hooke::integrator::{ImplicitScheme, LocalSubsteps, StabilityPolicy};
+    for policy in [
+        StabilityPolicy::Automatic,
+        StabilityPolicy::SwitchToImplicit(ImplicitScheme::Bdf2),
+        StabilityPolicy::SwitchToImplicit(ImplicitScheme::BackwardEuler),
+    ] {
+        let tag = match policy {
+            StabilityPolicy::SwitchToImplicit(s) => s.name(),
+            _ => "automatic",
+        };
         rescue_case(
             cfg,
             &format!("rescue_pendulum_{tag}_vs_symplectic_needed"),
-            scheme,
+            policy,
             |w| {
                 hooke::tools::scenes::stiff_rod_pendulum(w, 1e6).unwrap();
             },
@@ -249,41 +289,45 @@ pub fn rescue_costs(cfg: &Config) {
         rescue_case(
             cfg,
             &format!("rescue_rope20_{tag}_vs_symplectic_needed"),
-            scheme,
-            |w| {
-                hooke::springs::ChainBuilder::rope(
-                    Vec3::new(0.0, 2.0, 0.0),
-                    Vec3::new(1.0, 2.0, 0.0),
-                    20,
-                )
-                .stiffness(20.0 * 0.1 * 9.81 / (1e-3 / 19.0))
-                .spawn(w)
-                .unwrap();
-            },
+            policy,
+            stiff_rope20,
         );
         rescue_case(
             cfg,
             &format!("rescue_softbar480_{tag}_vs_symplectic_needed"),
-            scheme,
-            |w| {
-                use hooke::soft::{CellSplit, Material, SoftBody, StrainModel, TetMesh};
-                let mesh =
-                    TetMesh::cuboid(Vec3::new(0.1, 1.0, 0.1), [2, 20, 2], CellSplit::Six).unwrap();
-                let material = Material::new(1e6, 0.3, 1000.0).unwrap();
-                let (mut nodes, body) = SoftBody::build(
-                    &mesh,
-                    Vec3::new(0.0, -0.5, 0.0),
-                    material,
-                    StrainModel::Corotated,
-                )
-                .unwrap();
-                for i in 0..nodes.len() {
-                    if nodes.positions()[i].y.abs() < 1e-5 {
-                        nodes.pin(i).unwrap();
-                    }
-                }
-                w.spawn((nodes, body));
-            },
+            policy,
+            soft_bar480,
+        );
+    }
+    for n in [9, 16, 32, 64] {
+        let mut local = world(4);
+        local.insert_resource(StabilityPolicy::Warn);
+        stiff_rope20(&mut local);
+        let springs: Vec<_> = local
+            .query_filtered::<bevy_ecs::entity::Entity, bevy_ecs::query::With<hooke::springs::Spring>>()
+            .iter(&local)
+            .collect();
+        for s in springs {
+            local
+                .entity_mut(s)
+                .insert(LocalSubsteps::try_new(n).unwrap());
+        }
+        let mut bdf2 = world(4);
+        bdf2.insert_resource(StabilityPolicy::SwitchToImplicit(ImplicitScheme::Bdf2));
+        stiff_rope20(&mut bdf2);
+        for _ in 0..30 {
+            local.step_physics();
+            bdf2.step_physics();
+        }
+        let (ours, reference) = compare(cfg, || local.step_physics(), || bdf2.step_physics());
+        line(
+            &format!("local_substeps_{n}_vs_bdf2_rope20"),
+            ours,
+            reference,
+            &format!(
+                "the stiff rope stepped {n} times per substep on its own vs solved by BDF2 (the automatic policy's crossover is {})",
+                hooke::integrator::stability::LOCAL_SUBSTEPS_CHEAPER_UP_TO
+            ),
         );
     }
 }

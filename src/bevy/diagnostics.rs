@@ -23,8 +23,11 @@ impl PhysicsDiagnosticsPlugin {
     pub const RIGID_BODIES: DiagnosticPath = DiagnosticPath::const_new("hooke/rigid_bodies");
     /// Bodies quarantined since start.
     pub const QUARANTINED: DiagnosticPath = DiagnosticPath::const_new("hooke/quarantined_total");
-    /// Systems switched to an implicit scheme by the stability policy since start.
+    /// Systems rescued by the stability policy since start (local substeps or implicit).
     pub const RESCUED: DiagnosticPath = DiagnosticPath::const_new("hooke/rescued");
+    /// Of those, the ones stepped by local substeps.
+    pub const RESCUED_BY_SUBSTEPS: DiagnosticPath =
+        DiagnosticPath::const_new("hooke/rescued_by_substeps");
     /// The energy the implicit schemes take from the motion (W): the rescue's price.
     pub const NUMERICAL_DAMPING: DiagnosticPath =
         DiagnosticPath::const_new("hooke/numerical_damping");
@@ -38,6 +41,7 @@ impl Plugin for PhysicsDiagnosticsPlugin {
             .register_diagnostic(Diagnostic::new(Self::RIGID_BODIES))
             .register_diagnostic(Diagnostic::new(Self::QUARANTINED))
             .register_diagnostic(Diagnostic::new(Self::RESCUED))
+            .register_diagnostic(Diagnostic::new(Self::RESCUED_BY_SUBSTEPS))
             .register_diagnostic(Diagnostic::new(Self::NUMERICAL_DAMPING).with_suffix("W"));
         let schedule = app
             .world()
@@ -65,6 +69,9 @@ fn measure(diag: Option<Res<PhysicsDiagnostics>>, mut out: Diagnostics) {
         d.quarantined_total as f64
     });
     out.add_measurement(&PhysicsDiagnosticsPlugin::RESCUED, || d.rescued as f64);
+    out.add_measurement(&PhysicsDiagnosticsPlugin::RESCUED_BY_SUBSTEPS, || {
+        d.rescued_by_substeps as f64
+    });
     out.add_measurement(&PhysicsDiagnosticsPlugin::NUMERICAL_DAMPING, || {
         d.numerical_damping
     });

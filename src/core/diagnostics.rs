@@ -90,9 +90,11 @@ pub struct PhysicsDiagnostics {
     /// Systems (spring meshes, the entity springs, soft bodies) warned to be past their
     /// stability limit (each once).
     pub stability_warnings: u64,
-    /// Of those, the ones [`crate::integrator::StabilityPolicy`] switched to an implicit
-    /// scheme (since the world started).
+    /// Of those, the ones [`crate::integrator::StabilityPolicy`] rescued, by local substeps or
+    /// an implicit scheme (since the world started).
     pub rescued: u64,
+    /// Of the rescued, the ones stepped by [`crate::integrator::stability::LocalSubsteps`].
+    pub rescued_by_substeps: u64,
     /// The energy the implicit schemes take from the motion beyond what the model's own
     /// damping takes, summed over every implicitly solved system (W = J/s, averaged over about
     /// a second): the price of the rescue, in the motion it removes. Zero when nothing is

@@ -137,6 +137,17 @@ pub enum ImplicitSystems {
     Springs,
 }
 
+/// The stages inside [`StepSystems::IntegratePositions`]: the integrators' position phase,
+/// then corrections that systems stepped on their own hand to their bodies (a locally
+/// substepped spring's end lands where its own steps took it).
+#[derive(SystemSet, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PositionSystems {
+    /// Positions and orientations advance from velocities.
+    Integrate,
+    /// Poses corrected by the systems that stepped them.
+    Correct,
+}
+
 /// The stages inside [`StepSystems::RelaxConstraints`]: the rigid contacts' relax pass, then
 /// the soft bodies' attachments (which move rigid bodies too) and node contacts, which have
 /// the last word on where a node may be.
@@ -295,6 +306,11 @@ pub(crate) fn init_schedules(world: &mut World) {
         (ImplicitSystems::SoftBodies, ImplicitSystems::Springs)
             .chain()
             .in_set(IntegrationSystems::Integrate),
+    );
+    substep.configure_sets(
+        (PositionSystems::Integrate, PositionSystems::Correct)
+            .chain()
+            .in_set(StepSystems::IntegratePositions),
     );
     substep.configure_sets(
         (RelaxSystems::Rigid, RelaxSystems::Soft, RelaxSystems::Cloth)

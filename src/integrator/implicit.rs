@@ -489,19 +489,26 @@ pub(crate) fn step<E: ImplicitElements>(
         if !gnorm.is_finite() {
             return None;
         }
+        // The forces on the nodes at this iterate: external and elastic.
+        let mut load = 0.0f64;
+        for i in 0..len {
+            if free[i] {
+                load += (d3(n.f[i]).length() + d3(s.elastic[i]).length()).powi(2);
+            }
+        }
+        let load = load.sqrt();
         if it == 0 {
             // The force scale of the step: the first gradient, or, for a body already at rest
             // (where that is only rounding), the forces on its nodes. Not its momentum over
             // h: at small h that dwarfs the forces, and a tolerance on it would accept the
             // predictor without any elastic force at all.
-            let mut load = 0.0f64;
-            for i in 0..len {
-                if free[i] {
-                    load += (d3(n.f[i]).length() + d3(s.elastic[i]).length()).powi(2);
-                }
-            }
-            g0 = gnorm.max(load.sqrt());
+            g0 = gnorm.max(load);
         }
+        // The tolerance is relative to the smaller of that and the forces now: a stiff rod
+        // swinging round is predicted far off its length, and its first gradient (k times
+        // that) dwarfs the weight and tension the swing runs on; a residual of 1e-3 of it
+        // would be a force the size of gravity, and the pendulum would run 1% slow.
+        let scale = g0.min(load.max(f64::MIN_POSITIVE));
         report.residual = if g0 > 0.0 { (gnorm / g0) as f32 } else { 0.0 };
         // Converged; or stalled at the floor that f32 positions set (near 1e-4 of the first
         // gradient on a stiff body), where Newton can only shuffle rounding.
@@ -510,7 +517,7 @@ pub(crate) fn step<E: ImplicitElements>(
         // their contact planes is not a stall: the next Newton step answers the contact.
         let stalled =
             (gnorm > 0.5 * previous && gnorm < 1e-2 * g0) || (gnorm > 0.9 * previous && !clamped);
-        if g0 == 0.0 || gnorm <= f64::from(settings.tolerance) * g0 || stalled {
+        if g0 == 0.0 || gnorm <= f64::from(settings.tolerance) * scale || stalled {
             break;
         }
         previous = gnorm;

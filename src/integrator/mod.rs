@@ -48,8 +48,9 @@ pub(crate) type ExplicitMesh = (
     Without<crate::core::quarantine::Quarantined>,
     Without<crate::core::rest::Sleeping>,
     Without<ImplicitEuler>,
+    Without<stability::LocalSubsteps>,
 );
-pub use stability::{StabilityPolicy, StabilityWarning};
+pub use stability::{LocalSubsteps, Rescue, StabilityPolicy, StabilityWarning};
 pub use stages::{AngularRk4, Rk4Scratch};
 
 use bevy_ecs::prelude::*;
@@ -169,9 +170,9 @@ impl Integrator {
 #[require(ImplicitState)]
 pub struct ImplicitEuler {
     /// Newton stops when the gradient's norm has fallen below this fraction of the step's
-    /// force scale — its first gradient, or for a body at rest its weight and momentum over
-    /// h (dimensionless; default 1e-3) — or when it stalls at the floor that f32 positions set
-    /// (about 1e-4 of that scale on a stiff body).
+    /// force scale — the smaller of its first gradient and the external and elastic forces
+    /// on the nodes at the iterate (dimensionless; default 1e-3) — or when it stalls at the
+    /// floor that f32 positions set (about 1e-4 of the first gradient on a stiff body).
     pub tolerance: f32,
     /// Newton iterations per substep at most (default 8).
     pub max_newton: u32,

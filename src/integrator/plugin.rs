@@ -9,8 +9,8 @@ use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::{DivergenceGuard, Quarantined, quarantine_non_finite};
 use crate::core::rest::Simulated;
 use crate::core::schedule::{
-    IntegrationSystems, MeasureSystems, PhysicsSchedule, PrepareSystems, StepSystems,
-    SubstepSchedule, add_own_force_systems, add_own_systems,
+    IntegrationSystems, MeasureSystems, PhysicsSchedule, PositionSystems, PrepareSystems,
+    StepSystems, SubstepSchedule, add_own_force_systems, add_own_systems,
 };
 use crate::core::time::SubstepTime;
 use crate::particles::{
@@ -91,10 +91,10 @@ impl WorldPlugin for IntegratorPlugin {
                 super::rotation::integrate_angular_momenta
                     .run_if(any_with_component::<Inertia>)
                     .in_set(IntegrationSystems::Integrate),
-                integrate_positions.in_set(StepSystems::IntegratePositions),
+                integrate_positions.in_set(PositionSystems::Integrate),
                 super::rotation::integrate_orientations
                     .run_if(any_with_component::<Inertia>)
-                    .in_set(StepSystems::IntegratePositions),
+                    .in_set(PositionSystems::Integrate),
                 super::stages::complete_stages
                     .run_if(super::stages::needs_stages)
                     .in_set(StepSystems::CompleteStages),

@@ -15,53 +15,200 @@
 //! their limit and compare it with the substep dt / substeps.
 //!
 //! **[`StabilityPolicy`]** decides what happens to a system past its limit. The default,
-//! [`StabilityPolicy::SwitchToImplicit`] with [`ImplicitScheme::Bdf2`], solves it implicitly
-//! from that step on by BDF2, which is stable at any stiffness and damps only the motions too
-//! fast for the step: a pendulum on a stiff rod keeps its swing, a taut string its tone. It
-//! costs one Newton solve per substep, as backward Euler does (which stays available as
-//! `SwitchToImplicit(BackwardEuler)`, and on the [`super::Integrator`] dial). The policy acts on
-//! systems integrated by [`super::Integrator::SymplecticEuler`] (the default); one given
-//! another integrator on purpose keeps it and is only warned. Each decision is written once
-//! as a [`StabilityWarning`] and counted in
-//! [`crate::core::diagnostics::PhysicsDiagnostics::rescued`]; what the implicit scheme then
-//! takes from the motion is measured in
+//! [`StabilityPolicy::Automatic`], takes the cheapest [`Rescue`] that keeps the motion:
+//!
+//! - **[`Rescue::LocalSubsteps`]**: the system alone is stepped explicitly n times per substep
+//!   (h/n < h_crit), everything else once. Exact symplectic Euler at a finer step: no
+//!   numerical damping, and cheaper than a Newton solve while n is below about 70 (a stiff
+//!   rope of twenty beads needs 9 and costs a third of BDF2; a top on a stiff pivot needs 8). Chosen for spring systems (meshes and
+//!   the entity springs) while n ≤ [`LOCAL_SUBSTEPS_CHEAPER_UP_TO`], the count below which it
+//!   measures cheaper than BDF2 (`examples/perf_report`, `rescue_*` lines), and for springs
+//!   anchored off a rigid body's centre up to [`MAX_LOCAL_SUBSTEPS`], because their implicit
+//!   alternative, backward Euler, takes a spinning top's spin.
+//! - **[`Rescue::Implicit`]**`(`[`ImplicitScheme::Bdf2`]`)`: past that count, and for soft
+//!   bodies. Stable at any stiffness; it damps only the motions too fast for the step: a
+//!   pendulum on a stiff rod keeps its swing, a taut string its tone. One Newton solve per
+//!   substep.
+//! - **[`Rescue::Implicit`]**`(`[`ImplicitScheme::BackwardEuler`]`)`, last: springs anchored off
+//!   a body's centre that need more than [`MAX_LOCAL_SUBSTEPS`] (BDF2's position correction
+//!   cannot turn a body). It damps every motion.
+//!
+//! [`StabilityPolicy::SwitchToImplicit`] always takes the implicit scheme it names (backward
+//! Euler stays on the [`super::Integrator`] dial too), and [`StabilityPolicy::Warn`] only
+//! warns. The policy acts on systems integrated by [`super::Integrator::SymplecticEuler`]
+//! (the default); one given another integrator on purpose keeps it and is only warned. Each
+//! decision is written once as a [`StabilityWarning`] and counted in
+//! [`crate::core::diagnostics::PhysicsDiagnostics::rescued`] (by kind in
+//! `rescued_by_substeps`); what an implicit scheme then takes from the motion is measured in
 //! [`crate::core::diagnostics::PhysicsDiagnostics::numerical_damping`].
 
 use bevy_ecs::prelude::*;
 
 use super::{ImplicitScheme, Integrator};
 
+/// Local substeps per substep at most that [`StabilityPolicy::Automatic`] takes before it
+/// solves a spring system by BDF2 instead: measured, BDF2's Newton solve costs about as much
+/// as 70 local substeps of the same springs (a 20-bead rope: 9 local substeps cost 0.34 of
+/// BDF2, 64 cost 0.92; `examples/perf_report`, `local_substeps_*` lines).
+pub const LOCAL_SUBSTEPS_CHEAPER_UP_TO: u32 = 64;
+
+/// Local substeps per substep at most for springs anchored off a rigid body's centre, whose
+/// only implicit rescue, backward Euler, damps the body's spin; past it, backward Euler.
+pub const MAX_LOCAL_SUBSTEPS: u32 = 256;
+
 /// What hooke does with a system (a spring mesh, the entity springs, a soft body) whose
 /// explicit stability limit is below the substep. A resource.
-#[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(
+    serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Hash, Default,
+)]
 pub enum StabilityPolicy {
+    /// The cheapest rescue that keeps the motion (see the module docs): local substeps for a
+    /// spring system that needs few, BDF2 otherwise. The default.
+    #[default]
+    Automatic,
     /// Solve it implicitly by this scheme from then on (an [`super::ImplicitEuler`] is put on
-    /// it), and write a [`StabilityWarning`] saying so. The default is
-    /// [`ImplicitScheme::Bdf2`], which keeps the motion the step can resolve.
+    /// it), and write a [`StabilityWarning`] saying so.
     SwitchToImplicit(ImplicitScheme),
     /// Keep integrating it explicitly and write a [`StabilityWarning`]; the
     /// [`crate::core::quarantine::DivergenceGuard`] catches what then runs away.
     Warn,
 }
 
-impl Default for StabilityPolicy {
-    fn default() -> Self {
-        StabilityPolicy::SwitchToImplicit(ImplicitScheme::Bdf2)
+/// How a system past its explicit limit is integrated from then on.
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Rescue {
+    /// Stepped explicitly this many times per substep, on its own ([`LocalSubsteps`]).
+    LocalSubsteps(u32),
+    /// Solved implicitly by this scheme ([`super::ImplicitEuler`]).
+    Implicit(ImplicitScheme),
+}
+
+impl Rescue {
+    /// A short lowercase name for reports: `local_substeps`, `bdf2`, `backward_euler`.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Rescue::LocalSubsteps(_) => "local_substeps",
+            Rescue::Implicit(s) => s.name(),
+        }
     }
 }
 
+/// What a system past its limit offers the policy.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RescueOptions {
+    /// Local substeps per substep that would keep it stable, if it can be stepped on its own
+    /// (spring systems can; soft bodies cannot yet).
+    pub local_substeps: Option<u32>,
+    /// Whether BDF2 is out: springs anchored off a rigid body's centre, whose correction
+    /// would have to turn the body.
+    pub no_bdf2: bool,
+}
+
 impl StabilityPolicy {
-    /// The scheme a system integrated by `method` is switched to, if any: only systems
-    /// under [`Integrator::SymplecticEuler`] (the default) are switched.
+    /// The rescue of a system integrated by `method` (only systems under
+    /// [`Integrator::SymplecticEuler`], the default, are rescued) given its `options`.
+    #[must_use]
+    pub fn choose(self, method: Integrator, options: RescueOptions) -> Option<Rescue> {
+        if method != Integrator::SymplecticEuler {
+            return None;
+        }
+        let implicit = |s: ImplicitScheme| {
+            Rescue::Implicit(if options.no_bdf2 {
+                ImplicitScheme::BackwardEuler
+            } else {
+                s
+            })
+        };
+        match self {
+            StabilityPolicy::Warn => None,
+            StabilityPolicy::SwitchToImplicit(s) => Some(implicit(s)),
+            StabilityPolicy::Automatic => {
+                let cap = if options.no_bdf2 {
+                    MAX_LOCAL_SUBSTEPS
+                } else {
+                    LOCAL_SUBSTEPS_CHEAPER_UP_TO
+                };
+                Some(match options.local_substeps {
+                    Some(n) if n <= cap => Rescue::LocalSubsteps(n.max(2)),
+                    _ => implicit(ImplicitScheme::Bdf2),
+                })
+            }
+        }
+    }
+
+    /// The implicit scheme a system that can only be solved implicitly (a soft body) is
+    /// switched to under `method`, if any.
     #[must_use]
     pub fn rescue(self, method: Integrator) -> Option<ImplicitScheme> {
-        match self {
-            StabilityPolicy::SwitchToImplicit(s) if method == Integrator::SymplecticEuler => {
-                Some(s)
-            }
+        match self.choose(
+            method,
+            RescueOptions {
+                local_substeps: None,
+                no_bdf2: false,
+            },
+        ) {
+            Some(Rescue::Implicit(s)) => Some(s),
             _ => None,
         }
     }
+}
+
+/// A system (a [`crate::springs::SpringNetwork`] mesh, or a [`crate::springs::Spring`]
+/// entity) stepped explicitly [`LocalSubsteps::count`] times per substep on its own, with
+/// the substep's other forces held: the rescue [`StabilityPolicy::Automatic`] puts on a
+/// spring system that needs few more substeps than the world's. Game code may add it too.
+/// The entity springs share one local integration, at the largest count among them.
+#[derive(
+    serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Hash,
+)]
+#[serde(try_from = "u32", into = "u32")]
+pub struct LocalSubsteps {
+    count: u32,
+}
+
+impl TryFrom<u32> for LocalSubsteps {
+    type Error = crate::core::error::Error;
+
+    fn try_from(count: u32) -> crate::core::error::Result<Self> {
+        Self::try_new(count)
+    }
+}
+
+impl From<LocalSubsteps> for u32 {
+    fn from(local: LocalSubsteps) -> u32 {
+        local.count
+    }
+}
+
+impl LocalSubsteps {
+    /// `count` local substeps per substep, 1 to [`MAX_LOCAL_SUBSTEPS`].
+    ///
+    /// # Errors
+    /// [`crate::core::error::Error::OutOfRange`] outside that range.
+    pub fn try_new(count: u32) -> crate::core::error::Result<Self> {
+        if !(1..=MAX_LOCAL_SUBSTEPS).contains(&count) {
+            return Err(crate::core::error::Error::OutOfRange {
+                what: "local substeps",
+                value: count as f32,
+                range: "1 to 256",
+            });
+        }
+        Ok(Self { count })
+    }
+
+    /// Local substeps per substep.
+    #[must_use]
+    pub fn count(self) -> u32 {
+        self.count
+    }
+}
+
+/// Local substeps per substep of `substep` (s) that keep a system of limit `h_crit` stable,
+/// with a 10% margin (at least 1).
+#[must_use]
+pub fn local_substeps_needed(substep: f32, h_crit: f32) -> u32 {
+    substeps_needed(substep, h_crit)
 }
 
 /// Written once per system whose explicit stability limit is below the substep.
@@ -75,8 +222,8 @@ pub struct StabilityWarning {
     pub substep: f32,
     /// Substeps per step that would keep it stable under the explicit integrators.
     pub substeps_needed: u32,
-    /// The implicit scheme [`StabilityPolicy`] switched it to; None if it stays explicit.
-    pub rescue: Option<ImplicitScheme>,
+    /// What [`StabilityPolicy`] switched it to; None if it stays as it was.
+    pub rescue: Option<Rescue>,
 }
 
 impl StabilityWarning {
@@ -84,7 +231,11 @@ impl StabilityWarning {
     #[must_use]
     pub fn advice(&self) -> String {
         match self.rescue {
-            Some(scheme) => format!(
+            Some(Rescue::LocalSubsteps(n)) => format!(
+                "{:?} is too stiff for the substep ({:.2e} s > its limit {:.2e} s): it is stepped {n} times per substep on its own from now on ({} substeps would keep the whole world explicit)",
+                self.entity, self.substep, self.critical_step, self.substeps_needed
+            ),
+            Some(Rescue::Implicit(scheme)) => format!(
                 "{:?} is too stiff for explicit integration (substep {:.2e} s > its limit {:.2e} s): it is solved by {} from now on; {} substeps would keep it explicit",
                 self.entity,
                 self.substep,
@@ -108,7 +259,7 @@ pub(crate) fn tell(
     entity: Entity,
     critical_step: f32,
     (dt, substep): (f32, f32),
-    rescue: Option<ImplicitScheme>,
+    rescue: Option<Rescue>,
 ) {
     warnings.write(StabilityWarning {
         entity,
@@ -120,6 +271,7 @@ pub(crate) fn tell(
     if let Some(d) = diag {
         d.stability_warnings += 1;
         d.rescued += u64::from(rescue.is_some());
+        d.rescued_by_substeps += u64::from(matches!(rescue, Some(Rescue::LocalSubsteps(_))));
     }
 }
 

@@ -86,6 +86,7 @@ use crate::integrator::ImplicitByDial;
 use crate::integrator::ImplicitEuler;
 use crate::integrator::ImplicitState;
 use crate::integrator::IntegratorOverride;
+use crate::integrator::LocalSubsteps;
 use crate::particles::ExternalForce;
 use crate::particles::ExternalImpulse;
 use crate::particles::Force;
@@ -161,6 +162,7 @@ plain!(
     ImplicitState,
     ImplicitByDial,
     IntegratorOverride,
+    LocalSubsteps,
     Cloth,
     SoftBody,
     NodeTargets,
@@ -420,6 +422,7 @@ columns!(
     implicit_state: ImplicitState,
     implicit_by_dial: ImplicitByDial,
     integrator_override: IntegratorOverride,
+    local_substeps: LocalSubsteps,
     cloth: Cloth,
     soft_body: SoftBody,
     node_targets: NodeTargets,

@@ -106,7 +106,7 @@ pub(crate) fn check_soft_stability(
             e,
             stability.critical_step,
             (time.dt(), substep),
-            rescue,
+            rescue.map(crate::integrator::Rescue::Implicit),
         );
     }
     if let Some(d) = diag.as_mut() {

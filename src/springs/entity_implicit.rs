@@ -168,13 +168,21 @@ type SolveContext<'w, 's> = (
 
 /// Solves every implicit entity spring of the world in one backward-Euler step and hands the
 /// resulting forces to the ends (see the module docs).
-#[allow(clippy::too_many_arguments)] // a system: each argument is one query or resource it reads
+#[allow(clippy::too_many_arguments, clippy::type_complexity)] // a system: one query or resource each
 pub(crate) fn solve_entity_springs(
     mut commands: Commands,
     global: Res<Integrator>,
     guard: Res<DivergenceGuard>,
     time: Res<SubstepTime>,
-    springs: Query<(Entity, &Spring, Option<&ImplicitEuler>), Without<Quarantined>>,
+    springs: Query<
+        (
+            Entity,
+            &Spring,
+            Option<&ImplicitEuler>,
+            Has<crate::integrator::LocalSubsteps>,
+        ),
+        Without<Quarantined>,
+    >,
     bodies: Query<EndBody, Without<Quarantined>>,
     spinning: Query<(Spinning, &Inertia), Without<Quarantined>>,
     mut forces: Query<&mut Force, Without<Quarantined>>,
@@ -188,11 +196,13 @@ pub(crate) fn solve_entity_springs(
     let s = &mut *solve;
     s.clear();
     let mut settings = None;
+    // Locally substepped springs join the solve while there is one (see `super::local`).
+    let solving = global == Integrator::ImplicitEuler || springs.iter().any(|s| s.2.is_some());
     // The nodes are numbered, and the system assembled, in spring order (see `crate::core::order`).
     let all =
         crate::core::order::stable(&springs, archetypes, spring_id.get(), &mut order, |i| i.0);
-    for (_, spring, flag) in all {
-        if !wants_implicit(global, flag.is_some()) {
+    for (_, spring, flag, local) in all {
+        if !(wants_implicit(global, flag.is_some()) || (local && solving)) {
             continue;
         }
         let (Ok(a), Ok(b)) = (bodies.get(spring.a), bodies.get(spring.b)) else {

@@ -195,16 +195,8 @@ pub(crate) fn solve_implicit_springs(
         }
         let network = network.bypass_change_detection();
         let n = nodes.bypass_change_detection();
-        if !network.fits(n) {
-            commands.entity(e).insert(Quarantined {
-                reason: QuarantineReason::InvalidInput(
-                    crate::core::error::Error::IndexOutOfRange {
-                        what: "spring network endpoint",
-                        index: network.max_index as usize,
-                        len: n.len(),
-                    },
-                ),
-            });
+        if let Some(reason) = network.misfit(n) {
+            commands.entity(e).insert(Quarantined { reason });
             continue;
         }
         let report = step(

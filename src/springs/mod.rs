@@ -33,6 +33,7 @@
 mod builders;
 mod entity_implicit;
 mod implicit;
+mod local;
 mod plugin;
 pub mod stability;
 
@@ -398,6 +399,17 @@ impl SpringNetwork {
                 spring_energy(x[a as usize], x[b as usize], self.rest[i], self.k[i])
             })
             .sum()
+    }
+
+    /// Why a mesh whose springs index past its nodes leaves the step, if they do.
+    pub(crate) fn misfit(&self, nodes: &Nodes) -> Option<QuarantineReason> {
+        (!self.fits(nodes)).then(|| {
+            QuarantineReason::InvalidInput(Error::IndexOutOfRange {
+                what: "spring network endpoint",
+                index: self.max_index as usize,
+                len: nodes.len(),
+            })
+        })
     }
 
     /// Adds every spring force into `nodes`' accumulators. Returns false (and does nothing)

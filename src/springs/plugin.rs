@@ -6,7 +6,6 @@ use glam::{Vec3, Vec3A};
 
 use super::{Spring, SpringNetwork, spring_energy, spring_force};
 use crate::core::diagnostics::{PhysicsDiagnostics, energy_on};
-use crate::core::error::Error;
 use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::{QuarantineReason, Quarantined};
 use crate::core::schedule::{
@@ -26,6 +25,7 @@ impl WorldPlugin for SpringPlugin {
         crate::core::whole_step::block_on::<Spring>(world);
         crate::core::whole_step::block_on::<SpringNetwork>(world);
         crate::core::whole_step::block_on::<crate::integrator::ImplicitEuler>(world);
+        crate::core::whole_step::block_on::<crate::integrator::LocalSubsteps>(world);
         add_own_force_systems(world, || {
             (
                 apply_spring_forces.run_if(any_with_component::<Spring>),
@@ -40,6 +40,7 @@ impl WorldPlugin for SpringPlugin {
             world,
             crate::core::schedule::SubstepSchedule,
             (
+                super::local::substep_entity_springs,
                 super::entity_implicit::solve_entity_springs,
                 super::entity_implicit::correct_end_positions,
             )
@@ -50,10 +51,23 @@ impl WorldPlugin for SpringPlugin {
         add_own_systems(
             world,
             crate::core::schedule::SubstepSchedule,
-            super::implicit::solve_implicit_springs
-                .run_if(any_with_component::<crate::integrator::ImplicitEuler>)
+            (
+                super::implicit::solve_implicit_springs
+                    .run_if(any_with_component::<crate::integrator::ImplicitEuler>),
+                super::local::substep_meshes
+                    .run_if(any_with_component::<crate::integrator::LocalSubsteps>),
+            )
+                .chain()
                 .in_set(crate::core::schedule::ImplicitSystems::Springs),
         );
+        add_own_systems(
+            world,
+            crate::core::schedule::SubstepSchedule,
+            super::local::correct_local_poses
+                .run_if(any_with_component::<Spring>)
+                .in_set(crate::core::schedule::PositionSystems::Correct),
+        );
+        world.init_resource::<super::local::LocalCorrections>();
         crate::core::restore::init::<super::EntitySpringStability>(world);
         crate::core::restore::init::<super::entity_implicit::EntitySpringFactor>(world);
         add_own_systems(
@@ -109,12 +123,20 @@ pub(crate) fn anchor_state(
     }
 }
 
-#[allow(clippy::too_many_arguments)] // a system: each argument is one query or resource it reads
+#[allow(clippy::too_many_arguments, clippy::type_complexity)] // a system: one query or resource each
 fn apply_spring_forces(
     mut commands: Commands,
     guard: Res<crate::core::quarantine::DivergenceGuard>,
     global: Res<crate::integrator::Integrator>,
-    springs: Query<(Entity, &Spring, Has<crate::integrator::ImplicitEuler>), Without<Quarantined>>,
+    springs: Query<
+        (
+            Entity,
+            &Spring,
+            Has<crate::integrator::ImplicitEuler>,
+            Has<crate::integrator::LocalSubsteps>,
+        ),
+        Without<Quarantined>,
+    >,
     states: Query<Endpoint, Without<Quarantined>>,
     ends: Query<super::entity_implicit::EndBody, Without<Quarantined>>,
     spinning: Query<Spinning, Without<Quarantined>>,
@@ -132,8 +154,8 @@ fn apply_spring_forces(
     // Forces on a shared end are summed in spring order (see `crate::core::order`).
     let all =
         crate::core::order::stable(&springs, archetypes, spring_id.get(), &mut order, |i| i.0);
-    for (spring, s, flagged) in all {
-        if super::entity_implicit::wants_implicit(global, flagged) {
+    for (spring, s, flagged, local) in all {
+        if local || super::entity_implicit::wants_implicit(global, flagged) {
             let accepts = |e: Entity| {
                 ends.get(e)
                     .is_ok_and(|(_, _, m, o)| super::entity_implicit::end_accepts(global, m, o))
@@ -248,24 +270,20 @@ fn orphaned(
 type ExplicitNetwork = (
     Without<Quarantined>,
     Without<crate::integrator::ImplicitEuler>,
+    Without<crate::integrator::LocalSubsteps>,
 );
 
 /// Explicit meshes only: an [`crate::integrator::ImplicitEuler`] mesh's springs act inside its
-/// solve.
+/// solve, a [`crate::integrator::LocalSubsteps`] mesh's inside its local steps.
 fn apply_network_forces(
     mut commands: Commands,
     mut meshes: Query<(Entity, &mut Nodes, &SpringNetwork), ExplicitNetwork>,
 ) {
     for (e, mut nodes, network) in &mut meshes {
-        if !network.accumulate(nodes.bypass_change_detection()) {
-            let len = nodes.len();
-            commands.entity(e).insert(Quarantined {
-                reason: QuarantineReason::InvalidInput(Error::IndexOutOfRange {
-                    what: "spring network endpoint",
-                    index: network.max_index as usize,
-                    len,
-                }),
-            });
+        if let Some(reason) = network.misfit(&nodes) {
+            commands.entity(e).insert(Quarantined { reason });
+        } else {
+            network.accumulate(nodes.bypass_change_detection());
         }
     }
 }

@@ -30,8 +30,11 @@ use bevy_ecs::prelude::*;
 use super::{Spring, SpringNetwork};
 use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::time::PhysicsTime;
-use crate::integrator::stability::{StabilityPolicy, StabilityWarning, critical_step, tell};
-use crate::integrator::{ImplicitEuler, ImplicitScheme, Integrator, IntegratorOverride};
+use crate::integrator::stability::{
+    LocalSubsteps, Rescue, RescueOptions, StabilityPolicy, StabilityWarning, critical_step,
+    local_substeps_needed, tell,
+};
+use crate::integrator::{ImplicitEuler, Integrator, IntegratorOverride};
 use crate::particles::{Mass, Nodes};
 
 /// A [`SpringNetwork`] mesh's explicit stability limit (see the module docs).
@@ -96,6 +99,28 @@ impl SpringNetwork {
     }
 }
 
+/// The smallest limit over the entity springs' ends.
+fn best_limit(rows: &HashMap<(Entity, [u32; 3]), (f32, f32)>) -> f32 {
+    limit(rows.values().copied())
+}
+
+/// Puts `rescue` on a mesh or spring (replacing the other kind, if any).
+fn put(commands: &mut Commands, e: Entity, rescue: Rescue) {
+    match rescue {
+        Rescue::LocalSubsteps(n) => {
+            if let Ok(local) = LocalSubsteps::try_new(n) {
+                commands.entity(e).insert(local);
+            }
+        }
+        Rescue::Implicit(scheme) => {
+            commands
+                .entity(e)
+                .remove::<LocalSubsteps>()
+                .insert(ImplicitEuler::solved_by(scheme));
+        }
+    }
+}
+
 /// Recomputes the limits that springs or masses changed, and warns once per system past it
 /// (switching it to an implicit scheme as [`StabilityPolicy`] says).
 #[allow(clippy::type_complexity, clippy::too_many_arguments)] // the change filters are the point
@@ -112,6 +137,7 @@ pub(crate) fn check_stability(
             &mut SpringStability,
             Has<ImplicitEuler>,
             Option<&IntegratorOverride>,
+            Option<&LocalSubsteps>,
         ),
         Without<crate::core::quarantine::Quarantined>,
     >,
@@ -128,7 +154,7 @@ pub(crate) fn check_stability(
     let mut smallest = f32::INFINITY;
     let mut warn = |entity: Entity,
                     h_crit: f32,
-                    rescue: Option<ImplicitScheme>,
+                    rescue: Option<Rescue>,
                     diag: &mut Option<ResMut<PhysicsDiagnostics>>| {
         tell(
             &mut warnings,
@@ -140,19 +166,38 @@ pub(crate) fn check_stability(
         );
     };
     let implicit_dial = global == Integrator::ImplicitEuler;
-    for (e, nodes, network, mut stability, implicit, o) in &mut meshes {
-        if !stability.computed || nodes.is_changed() || network.is_changed() {
+    for (e, nodes, network, mut stability, implicit, o, local) in &mut meshes {
+        let fresh = !stability.computed || nodes.is_changed() || network.is_changed();
+        if fresh {
             stability.critical_step = network.critical_step(&nodes);
             stability.computed = true;
         }
         smallest = smallest.min(stability.critical_step);
-        if !implicit && !implicit_dial && !stability.warned && substep > stability.critical_step {
-            stability.warned = true;
-            let rescue = policy.rescue(o.map_or(global, |o| o.0));
-            if let Some(scheme) = rescue {
-                commands.entity(e).insert(ImplicitEuler::solved_by(scheme));
+        if implicit || implicit_dial {
+            continue;
+        }
+        let options = RescueOptions {
+            local_substeps: Some(local_substeps_needed(substep, stability.critical_step)),
+            no_bdf2: false,
+        };
+        match local {
+            // Rescued by local substeps: re-decided (silently) if its springs or masses
+            // changed past what its count holds.
+            Some(l) if fresh && substep / l.count() as f32 > stability.critical_step => {
+                if let Some(rescue) = policy.choose(o.map_or(global, |o| o.0), options) {
+                    put(&mut commands, e, rescue);
+                }
             }
-            warn(e, stability.critical_step, rescue, &mut diag);
+            Some(_) => {}
+            None if !stability.warned && substep > stability.critical_step => {
+                stability.warned = true;
+                let rescue = policy.choose(o.map_or(global, |o| o.0), options);
+                if let Some(rescue) = rescue {
+                    put(&mut commands, e, rescue);
+                }
+                warn(e, stability.critical_step, rescue, &mut diag);
+            }
+            None => {}
         }
     }
     // The entity springs integrated explicitly; the implicit ones have no limit.
@@ -202,13 +247,13 @@ pub(crate) fn check_stability(
             (a != glam::Vec3::ZERO && inertias.contains(s.a()))
                 || (b != glam::Vec3::ZERO && inertias.contains(s.b()))
         });
-        let rescue = policy.rescue(Integrator::SymplecticEuler).map(|scheme| {
-            if levered {
-                ImplicitScheme::BackwardEuler
-            } else {
-                scheme
-            }
-        });
+        let rescue = policy.choose(
+            Integrator::SymplecticEuler,
+            RescueOptions {
+                local_substeps: Some(local_substeps_needed(substep, best_limit(&rows))),
+                no_bdf2: levered,
+            },
+        );
         for (e, s, _) in springs.iter().filter(|s| explicit(s.2)) {
             let mut over = false;
             let (anchor_a, anchor_b) = s.anchors();
@@ -245,9 +290,9 @@ pub(crate) fn check_stability(
                 &mut diag,
             );
         }
-        if let Some(scheme) = rescue {
+        if let Some(rescue) = rescue {
             for e in stiff {
-                commands.entity(e).insert(ImplicitEuler::solved_by(scheme));
+                put(&mut commands, e, rescue);
             }
         }
     }

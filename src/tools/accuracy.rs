@@ -69,17 +69,18 @@ pub struct Setting {
     pub integrator: Integrator,
     /// Substeps per fixed step (≥ 1).
     pub substeps: u32,
-    /// What [`StabilityPolicy`] switches a system past its explicit limit to: None keeps
-    /// every system on `integrator` (`StabilityPolicy::Warn`, the dial as it is), Some(s)
-    /// is the policy `SwitchToImplicit(s)`; the default policy is `Some(Bdf2)`.
-    pub rescue: Option<ImplicitScheme>,
+    /// The [`StabilityPolicy`] of the run: [`StabilityPolicy::Warn`] keeps every system on
+    /// `integrator` (the dial as it is); the default policy is
+    /// [`StabilityPolicy::Automatic`].
+    pub policy: StabilityPolicy,
 }
 
 impl Setting {
     /// hooke's defaults: symplectic Euler with 4 substeps ([`PhysicsTime::default`]), and the
-    /// default [`StabilityPolicy`] (BDF2 for what is past its limit).
+    /// default [`StabilityPolicy`] ([`StabilityPolicy::Automatic`]: local substeps or BDF2 for
+    /// what is past its limit).
     pub const DEFAULT: Setting =
-        Setting::new(Integrator::SymplecticEuler, 4).with_rescue(ImplicitScheme::Bdf2);
+        Setting::new(Integrator::SymplecticEuler, 4).with_policy(StabilityPolicy::Automatic);
 
     /// A setting of the dial: every system stays on `integrator`.
     #[must_use]
@@ -87,25 +88,34 @@ impl Setting {
         Self {
             integrator,
             substeps,
-            rescue: None,
+            policy: StabilityPolicy::Warn,
         }
     }
 
-    /// The same setting with the stability policy switching what is past its limit to
-    /// `scheme`.
+    /// The same setting under stability policy `policy`.
     #[must_use]
-    pub const fn with_rescue(mut self, scheme: ImplicitScheme) -> Self {
-        self.rescue = Some(scheme);
+    pub const fn with_policy(mut self, policy: StabilityPolicy) -> Self {
+        self.policy = policy;
         self
     }
 
-    /// The series name of the setting: the integrator, or the policy's rescue
-    /// (`policy→bdf2`).
+    /// The same setting with the stability policy switching what is past its limit to
+    /// `scheme` ([`StabilityPolicy::SwitchToImplicit`]).
+    #[must_use]
+    pub const fn with_rescue(self, scheme: ImplicitScheme) -> Self {
+        self.with_policy(StabilityPolicy::SwitchToImplicit(scheme))
+    }
+
+    /// The series name of the setting: the integrator, then the policy's rescue
+    /// (`symplectic_euler+bdf2`, `symplectic_euler+automatic`).
     #[must_use]
     pub fn series(&self) -> String {
-        match self.rescue {
-            None => self.integrator.name().to_string(),
-            Some(s) => format!("{}+{}", self.integrator.name(), s.name()),
+        match self.policy {
+            StabilityPolicy::Warn => self.integrator.name().to_string(),
+            StabilityPolicy::SwitchToImplicit(s) => {
+                format!("{}+{}", self.integrator.name(), s.name())
+            }
+            StabilityPolicy::Automatic => format!("{}+automatic", self.integrator.name()),
         }
     }
 
@@ -266,10 +276,7 @@ pub fn world_for(setting: Setting, dt: f32) -> Result<World> {
     world.insert_resource(PhysicsTime::new(dt, setting.substeps)?);
     world.add_physics(PhysicsPlugins);
     world.insert_resource(setting.integrator);
-    world.insert_resource(match setting.rescue {
-        Some(scheme) => StabilityPolicy::SwitchToImplicit(scheme),
-        None => StabilityPolicy::Warn,
-    });
+    world.insert_resource(setting.policy);
     Ok(world)
 }
 

@@ -549,6 +549,33 @@ pub fn stiff_rod_pendulum(world: &mut World, k: f32) -> Result<Entity> {
     Ok(bob)
 }
 
+/// A top of 1 kg (moments 0.02, 0.01, 0.02 kg·m² about its centre; y, the 0.01 one, is its
+/// symmetry axis) spinning at `spin` rad/s about that axis, tilted 0.3 rad about z, its tip
+/// 0.3 m below its centre held by a pivot spring of stiffness `k` (N/m, rest length 0) to a
+/// pin at the origin. At 1e6 N/m the pivot's mode, √(k (1/m + l²/I₁)) ≈ 2300 rad/s, is past
+/// the default substep's explicit limit. Returns the top.
+///
+/// # Errors
+/// As [`Spring::from_hooke`] for a bad `k`, and a non-finite `spin`.
+pub fn top_on_a_pivot(world: &mut World, k: f32, spin: f32) -> Result<Entity> {
+    use crate::rigid::{Inertia, MassProperties, RigidBodyBundle};
+    let inertia = Inertia::diagonal(0.02, 0.01, 0.02)?;
+    let tilt = glam::Quat::from_rotation_z(0.3);
+    let pin = world.spawn(ParticleBundle::pinned(Vec3::ZERO)?).id();
+    let top = world
+        .spawn(
+            RigidBodyBundle::dynamic(MassProperties::new(1.0, Vec3::ZERO, inertia)?)?
+                .at(tilt * Vec3::new(0.0, 0.3, 0.0))?
+                .with_rotation(tilt)?
+                .with_angular_velocity(tilt * Vec3::Y * spin)?,
+        )
+        .id();
+    Spring::from_hooke(pin, top, 0.0, k, 0.0)?
+        .with_anchors(Vec3::ZERO, Vec3::new(0.0, -0.3, 0.0))?
+        .spawn(world)?;
+    Ok(top)
+}
+
 /// The catenary parameter a (m) of a chain of `length` hung between two pins `span` apart
 /// at one height: the root of L = 2a sinh(S / 2a), by bisection (the right side falls as a
 /// grows). Its sag is a (cosh(S / 2a) − 1), its support tension w a cosh(S / 2a).

@@ -263,6 +263,9 @@ fn every_substep_system_is_replicated_or_blocks_the_path() {
         "hooke::springs::plugin::apply_network_forces", // SpringNetwork
         "hooke::springs::entity_implicit::solve_entity_springs", // Spring
         "hooke::springs::entity_implicit::correct_end_positions", // Spring
+        "hooke::springs::local::substep_entity_springs", // Spring
+        "hooke::springs::local::correct_local_poses", // Spring
+        "hooke::springs::local::substep_meshes",     // SpringNetwork, LocalSubsteps
         "hooke::springs::implicit::solve_implicit_springs", // SpringNetwork, ImplicitEuler
         "hooke::soft::plugin::apply_elastic_forces", // SoftBody
         "hooke::soft::plugin::solve_implicit",       // SoftBody, ImplicitEuler

@@ -184,6 +184,20 @@ fn rope_continues_bit_identically() {
 }
 
 #[test]
+fn locally_substepped_springs_continue_bit_identically() {
+    // Rescued at the defaults by local substeps: a stiff-rod pendulum and a top on a stiff
+    // pivot (entity springs), stepped on their own with their corrections in between.
+    round_trip(
+        |w| {
+            scenes::stiff_rod_pendulum(w, 1e6).unwrap();
+            scenes::top_on_a_pivot(w, 1e6, 200.0).unwrap();
+        },
+        nothing,
+        via_bytes,
+    );
+}
+
+#[test]
 fn cloth_continues_bit_identically() {
     round_trip(
         |w| {

@@ -11,7 +11,7 @@ use hooke::core::quarantine::Quarantined;
 use hooke::core::time::PhysicsTime;
 use hooke::integrator::StabilityPolicy;
 use hooke::integrator::StabilityWarning;
-use hooke::integrator::{ImplicitEuler, ImplicitScheme};
+use hooke::integrator::{ImplicitEuler, ImplicitScheme, Rescue};
 use hooke::prelude::*;
 use hooke::springs::ChainBuilder;
 use hooke::tools::scenes;
@@ -82,18 +82,22 @@ fn stiff_rope() -> ChainBuilder {
 
 use common::default_world;
 
-#[test]
-fn a_stiff_rope_just_works_at_the_defaults_the_policy_switches_it_to_bdf2() {
+/// A world at the defaults whose stability policy solves what is past its limit by BDF2
+/// (the policy's choice past its local-substep count, and what these tests exercise).
+fn bdf2_world() -> World {
     let mut w = default_world();
-    assert_eq!(
-        *w.resource::<StabilityPolicy>(),
-        StabilityPolicy::SwitchToImplicit(ImplicitScheme::Bdf2)
-    );
+    w.insert_resource(StabilityPolicy::SwitchToImplicit(ImplicitScheme::Bdf2));
+    w
+}
+
+#[test]
+fn a_stiff_rope_just_works_under_bdf2() {
+    let mut w = bdf2_world();
     let rope = stiff_rope().spawn(&mut w).unwrap();
     w.step_physics();
     let told = warnings(&w);
     assert_eq!(told.len(), 1, "{told:?}");
-    assert_eq!(told[0].rescue, Some(ImplicitScheme::Bdf2));
+    assert_eq!(told[0].rescue, Some(Rescue::Implicit(ImplicitScheme::Bdf2)));
     println!("{}", told[0].advice());
     for &s in &rope.springs {
         assert!(
@@ -124,8 +128,9 @@ fn a_stiff_rope_just_works_at_the_defaults_the_policy_switches_it_to_bdf2() {
 }
 
 #[test]
-fn a_stiff_rope_hung_straight_comes_to_rest_with_each_spring_carrying_the_weight_below() {
-    let mut w = default_world();
+fn a_stiff_rope_hung_straight_comes_to_rest_under_bdf2_with_each_spring_carrying_the_weight_below()
+{
+    let mut w = bdf2_world();
     let rope = ChainBuilder::rope(Vec3::new(0.0, 2.0, 0.0), Vec3::new(0.0, 1.0, 0.0), 20)
         .stiffness(20.0 * 0.1 * 9.81 / (1e-3 / 19.0))
         .spawn(&mut w)
@@ -208,7 +213,7 @@ fn box_body(m: f32, h: Vec3, x: Vec3) -> RigidBodyBundle {
 }
 
 #[test]
-fn a_rigid_box_on_a_stiff_spring_at_its_centre_hangs_at_the_static_stretch() {
+fn a_rigid_box_on_a_stiff_spring_at_its_centre_bobs_about_the_static_stretch() {
     // 10 kg box on a 1 m spring of 3.6e6 N/m from a pin: ω = 600 rad/s, ωh = 2.5 at 240 Hz
     // (explicitly unstable). Static stretch g / ω² = 2.725e-5 m.
     let mut w = default_world();
@@ -223,16 +228,22 @@ fn a_rigid_box_on_a_stiff_spring_at_its_centre_hangs_at_the_static_stretch() {
     w.step_physics();
     let told = warnings(&w);
     assert_eq!(told.len(), 1);
-    assert_eq!(told[0].rescue, Some(ImplicitScheme::Bdf2));
-    let mut farthest = 0.0f32;
-    for _ in 0..600 {
+    // ω = 600 rad/s: 2 local substeps per substep keep it explicit.
+    assert_eq!(told[0].rescue, Some(Rescue::LocalSubsteps(2)));
+    // Undamped, released at the rest length, it bobs between no stretch and twice the static
+    // one: the static stretch is the mean over the last 5 s.
+    let (mut farthest, mut mean) = (0.0f32, 0.0f64);
+    for step in 0..600 {
         w.step_physics();
         farthest = farthest.max(common::x(&w, body).length());
+        if step >= 300 {
+            mean += f64::from(-common::x(&w, body).y - 1.0) / 300.0;
+        }
     }
     let x = common::x(&w, body);
-    let stretch = -x.y - 1.0;
+    let stretch = mean as f32;
     println!(
-        "box: swung to {farthest:.5} m from the pin; rests at {x}, stretch {stretch:.3e} m (closed 2.725e-5)"
+        "box: swung to {farthest:.5} m from the pin; at {x} after 10 s, mean stretch {stretch:.3e} m (closed 2.725e-5)"
     );
     assert!(
         farthest < 1.001,
@@ -269,8 +280,8 @@ fn a_box_hung_off_centre_by_a_stiff_spring_swings_without_gaining_energy() {
     let e0 = total_energy(&w);
     let told = warnings(&w);
     assert_eq!(told.len(), 1, "the lever arm lowers the limit: {told:?}");
-    // Anchored off the centre: backward Euler (BDF2 would need an orientation correction).
-    assert_eq!(told[0].rescue, Some(ImplicitScheme::BackwardEuler));
+    // Anchored off the centre: the body is stepped whole, 4 times per substep.
+    assert_eq!(told[0].rescue, Some(Rescue::LocalSubsteps(4)));
     let (mut most, mut strain) = (f64::NEG_INFINITY, 0.0f32);
     for _ in 0..1200 {
         w.step_physics();
@@ -283,9 +294,11 @@ fn a_box_hung_off_centre_by_a_stiff_spring_swings_without_gaining_energy() {
     println!(
         "off-centre box, 20 s: energy gain at most {most:.3} J, at the end {e:.2} J; largest strain {strain:.2e}"
     );
-    // Backward Euler only removes energy; 0.5 J is the f32 rounding of a 400 J total.
+    // 0.5 J is the f32 rounding of a 400 J total. Stepped whole at a finer step, the box
+    // keeps its swing: only the spring's own damping (along it, where the motion is tiny)
+    // takes anything (backward Euler, the rescue before, took over 10 J).
     assert!(most < 0.5, "{most} J gained");
-    assert!(e < -10.0, "the swing is damped: {e} J");
+    assert!(e.abs() < 1.0, "the swing is kept: {e} J");
     assert!(strain < 2e-3, "{strain}");
 }
 
@@ -389,12 +402,35 @@ fn a_light_chain_holding_a_thousand_times_its_link_mass_settles() {
 }
 
 #[test]
-fn a_taut_string_of_light_masses_pinned_at_both_ends_settles() {
-    // 30 nodes of 1 g over 1 m, pre-stretched 5 % between two pins, k = 1e5 N/m.
+fn a_taut_string_of_light_masses_pinned_at_both_ends_moves_as_the_fine_explicit_reference() {
+    // 30 nodes of 1 g over 1 m, pre-stretched 5 % between two pins, k = 1e5 N/m: explicitly
+    // it needs about 170 substeps. Its dampers act along the springs only, so it does not
+    // settle in 5 s (an implicit rescue made it, by numerical damping); at the defaults it
+    // rings as the same string stepped explicitly at 256 substeps does.
     let mut w = default_world();
     let string = taut_string(&mut w);
-    settles("taut string", &mut w, &string.nodes, 5.0, 3.0);
+    let mut reference = default_world();
+    reference.insert_resource(StabilityPolicy::Warn);
+    reference.insert_resource(PhysicsTime::new(1.0 / 60.0, 256).unwrap());
+    let fine = taut_string(&mut reference);
+    let (mut gap, mut farthest) = (0.0f32, 0.0f32);
+    for _ in 0..300 {
+        w.step_physics();
+        reference.step_physics();
+        for (&a, &b) in string.nodes.iter().zip(&fine.nodes) {
+            gap = gap.max((common::x(&w, a) - common::x(&reference, b)).length());
+            farthest = farthest.max(common::x(&w, a).length());
+        }
+    }
+    let d = w.resource::<PhysicsDiagnostics>();
     let mid = common::x(&w, string.nodes[15]);
+    println!(
+        "taut string, 5 s at the defaults: largest gap to explicit x256 {gap:.2e} m, middle at {mid}"
+    );
+    assert_eq!(d.quarantined_total, 0);
+    assert_eq!(d.rescued_by_substeps, 1);
+    assert!(farthest < 3.0, "{farthest}");
+    assert!(gap < 1e-4, "{gap}");
     assert!((mid.y - 2.0).abs() < 1e-3, "barely sags: {mid}");
 }
 

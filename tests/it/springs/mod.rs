@@ -6,5 +6,6 @@ mod default_builders_stable;
 mod force_law_and_chains;
 mod implicit_entities;
 mod implicit_meshes;
+mod local_substeps;
 mod rescue_keeps_the_motion;
 mod stiff_springs_warned_and_caught;

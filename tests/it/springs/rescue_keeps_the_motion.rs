@@ -1,15 +1,17 @@
-//! What the default rescue keeps. A system too stiff for the substep is switched to BDF2
-//! (`StabilityPolicy`'s default), which damps only the motions too fast for the step: at the
-//! defaults (`PhysicsPlugins` and nothing else) a pendulum on a stiff rod keeps its period and
-//! swing, and a taut string its tone. Backward Euler, the previous rescue, took 40% of the
-//! pendulum's swing in 14 s and 72% of the string's amplitude per period.
+//! What the default rescue keeps. A system too stiff for the substep is rescued by
+//! `StabilityPolicy::Automatic` (the default): stepped on its own a few times per substep when
+//! that suffices, solved by BDF2 (which damps only the motions too fast for the step) when it
+//! would take more. At the defaults (`PhysicsPlugins` and nothing else) a pendulum on a stiff
+//! rod keeps its period and swing under either, a taut string its tone, and a top on a stiff
+//! pivot its spin. Backward Euler, the first rescue, took 40% of the pendulum's swing in 14 s,
+//! 72% of the string's amplitude per period and 74% of the top's spin in 10 s.
 
 use crate::common;
 
 use bevy_ecs::message::Messages;
 use bevy_ecs::prelude::*;
 use glam::Vec3;
-use hooke::integrator::{ImplicitScheme, StabilityWarning};
+use hooke::integrator::{ImplicitScheme, Rescue, StabilityWarning};
 use hooke::prelude::*;
 use hooke::springs::ChainBuilder;
 use hooke::tools::scenes;
@@ -31,9 +33,17 @@ fn elliptic_k(m: f64) -> f64 {
 #[test]
 fn a_pendulum_on_a_stiff_rod_keeps_its_period_and_swing_at_the_defaults() {
     // 1 kg on a 1 m spring of 1e6 N/m: the rod's own mode is 1000 rad/s, h_crit = 2 ms, past
-    // the default 1/240 s substep. Released from rest at 90°.
+    // the default 1/240 s substep: stepped 3 times per substep on its own.
+    stiff_rod_pendulum(1e6, Rescue::LocalSubsteps(3));
+    // At 1e9 N/m (h_crit = 63 µs) that would take 74: BDF2 is cheaper.
+    stiff_rod_pendulum(1e9, Rescue::Implicit(ImplicitScheme::Bdf2));
+}
+
+/// A 1 kg bob on a 1 m rod of stiffness `k`, released from rest at 90° at the defaults: the
+/// policy chooses `rescue`, and the period and swing hold over 10 periods.
+fn stiff_rod_pendulum(k: f32, rescue: Rescue) {
     let mut w = common::default_world();
-    let bob = scenes::stiff_rod_pendulum(&mut w, 1e6).unwrap();
+    let bob = scenes::stiff_rod_pendulum(&mut w, k).unwrap();
     let g = 9.81f64;
     // 4 √(L/g) K(sin²(θ₀/2)) at θ₀ = 90°.
     let period = 4.0 * (1.0 / g).sqrt() * elliptic_k(0.5);
@@ -44,7 +54,7 @@ fn a_pendulum_on_a_stiff_rod_keeps_its_period_and_swing_at_the_defaults() {
         if step == 1 {
             let first = told(&w);
             assert_eq!(first.len(), 1, "{first:?}");
-            assert_eq!(first[0].rescue, Some(ImplicitScheme::Bdf2));
+            assert_eq!(first[0].rescue, Some(rescue));
             println!("{}", first[0].advice());
         }
         w.step_physics();
@@ -76,7 +86,8 @@ fn a_pendulum_on_a_stiff_rod_keeps_its_period_and_swing_at_the_defaults() {
         .fold(0.0f32, f32::max)
         .to_degrees();
     println!(
-        "stiff-rod pendulum at the defaults: period {measured:.4} s (closed {period:.4} s, {:+.2}%), swing in the 10th period {amplitude:.2}° of 90°",
+        "stiff-rod pendulum of {k:e} N/m at the defaults ({}): period {measured:.4} s (closed {period:.4} s, {:+.2}%), swing in the 10th period {amplitude:.2}° of 90°",
+        rescue.name(),
         100.0 * (measured / period - 1.0)
     );
     assert!((measured / period - 1.0).abs() < 0.01, "{measured}");
@@ -189,4 +200,59 @@ fn the_price_of_the_rescue_is_in_the_diagnostics_and_agrees_with_the_energy_lost
     // BDF2 keeps the swing: a hundredth of backward Euler's price, in the loss and the report.
     assert!(bdf2_lost.abs() < 0.01 * be_lost, "{bdf2_lost}");
     assert!(bdf2_rate.abs() < 0.01 * be_rate, "{bdf2_rate}");
+    // The default's local substeps are symplectic Euler at a finer step: nothing to report,
+    // and the energy is kept to its O(h) oscillation.
+    let (local_lost, local_rate) =
+        pendulum_price(hooke::integrator::StabilityPolicy::Automatic, seconds);
+    println!("local substeps (the default): lost {local_lost:.2e} J, reported {local_rate:.2e} W");
+    assert!(local_lost.abs() < 0.01 * be_lost, "{local_lost}");
+    assert_eq!(local_rate, 0.0);
+}
+
+/// The spin about the top's own axis (rad/s) and the axis' tilt from the vertical (rad).
+fn spin_and_tilt(w: &World, top: Entity) -> (f32, f32) {
+    let q = w.get::<Rotation>(top).unwrap().0;
+    let axis = q * Vec3::Y;
+    let omega = Vec3::from(w.get::<AngularVelocity>(top).unwrap().0);
+    (omega.dot(axis), axis.angle_between(Vec3::Y))
+}
+
+#[test]
+fn a_top_on_a_stiff_pivot_keeps_its_spin_at_the_defaults() {
+    // A fast top (L₃² = 4 ≫ 4 I₁' m g l = 1.3): it precesses slowly with a small nutation, and
+    // its spin about its own axis is conserved exactly (no torque about a symmetry axis
+    // through the pivot). The pivot's mode is about √(k (1/m + l²/I₁)) = 2300 rad/s at 1e6
+    // N/m, h_crit ≈ 0.85 ms: past the default substep. The reference is the same top
+    // integrated explicitly at 64 substeps (h = 0.26 ms).
+    let (k, spin) = (1e6f32, 200.0f32);
+    let mut w = common::default_world();
+    let top = scenes::top_on_a_pivot(&mut w, k, spin).unwrap();
+    let mut reference = common::default_world();
+    reference.insert_resource(hooke::integrator::StabilityPolicy::Warn);
+    reference.insert_resource(hooke::core::time::PhysicsTime::new(1.0 / 60.0, 64).unwrap());
+    let top_ref = scenes::top_on_a_pivot(&mut reference, k, spin).unwrap();
+    w.step_physics();
+    reference.step_physics();
+    let told = told(&w);
+    assert_eq!(told.len(), 1, "{told:?}");
+    let Some(Rescue::LocalSubsteps(n)) = told[0].rescue else {
+        panic!("{told:?}");
+    };
+    let (spin0, _) = spin_and_tilt(&w, top);
+    let mut tilt_gap = 0.0f32;
+    for _ in 0..600 {
+        w.step_physics();
+        reference.step_physics();
+        tilt_gap =
+            tilt_gap.max((spin_and_tilt(&w, top).1 - spin_and_tilt(&reference, top_ref).1).abs());
+    }
+    let (spin1, tilt) = spin_and_tilt(&w, top);
+    let (_, tilt_ref) = spin_and_tilt(&reference, top_ref);
+    println!(
+        "top on a {k:e} N/m pivot, 10 s at the defaults ({n} local substeps): spin {spin0:.3} → {spin1:.3} rad/s ({:+.4}%), tilt {tilt:.3} rad (explicit ×64: {tilt_ref:.3}; largest gap {tilt_gap:.3} rad)",
+        100.0 * (spin1 / spin0 - 1.0)
+    );
+    assert_eq!(w.resource::<PhysicsDiagnostics>().quarantined_total, 0);
+    assert!((spin1 / spin0 - 1.0).abs() < 0.01, "{spin1} of {spin0}");
+    assert!(tilt_gap < 0.05, "{tilt_gap}");
 }
