@@ -12,7 +12,7 @@ const SERIES: [(&str, RGBColor); 15] = [
     ("velocity_verlet", RGBColor(44, 160, 44)),
     ("rk4", RGBColor(148, 103, 189)),
     ("implicit_euler", RGBColor(255, 127, 14)),
-    ("symplectic_euler+automatic", RGBColor(220, 20, 60)),
+    ("symplectic_euler+automatic", RGBColor(184, 134, 11)),
     ("symplectic_euler+bdf2", RGBColor(0, 0, 139)),
     ("symplectic_euler+backward_euler", RGBColor(255, 187, 120)),
     ("Green", RGBColor(23, 190, 207)),

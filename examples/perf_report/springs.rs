@@ -268,7 +268,7 @@ fn soft_bar480(w: &mut World) {
 /// choice), BDF2 and backward Euler. Then where local substeps stop being cheaper than BDF2:
 /// the rope stepped n times per substep on its own against the rope under BDF2.
 pub fn rescue_costs(cfg: &Config) {
-    use hooke::integrator::{ImplicitScheme, LocalSubsteps, StabilityPolicy};
+    use hooke::integrator::{ImplicitScheme, StabilityPolicy};
     for policy in [
         StabilityPolicy::Automatic,
         StabilityPolicy::SwitchToImplicit(ImplicitScheme::Bdf2),
@@ -299,34 +299,52 @@ pub fn rescue_costs(cfg: &Config) {
             soft_bar480,
         );
     }
-    for n in [9, 16, 32, 64] {
+    local_vs_bdf2(cfg, "softbar480", &[12, 16, 24, 32], soft_bar480, || {
+        hooke::soft::stability::LOCAL_SUBSTEPS_CHEAPER_UP_TO
+    });
+    local_vs_bdf2(cfg, "rope20", &[9, 16, 32, 64], stiff_rope20, || {
+        hooke::springs::stability::LOCAL_SUBSTEPS_CHEAPER_UP_TO
+    });
+}
+
+/// A scene's systems (its meshes and springs) stepped n times per substep on their own (each n of `counts`) against
+/// the same scene solved by BDF2, at the defaults' 60 Hz × 4.
+fn local_vs_bdf2(
+    cfg: &Config,
+    tag: &str,
+    counts: &[u32],
+    spawn: impl Fn(&mut World),
+    crossover: impl Fn() -> u32,
+) {
+    use hooke::integrator::{ImplicitScheme, LocalSubsteps, StabilityPolicy};
+    for &n in counts {
         let mut local = world(4);
         local.insert_resource(StabilityPolicy::Warn);
-        stiff_rope20(&mut local);
-        let springs: Vec<_> = local
-            .query_filtered::<bevy_ecs::entity::Entity, bevy_ecs::query::With<hooke::springs::Spring>>()
+        spawn(&mut local);
+        let systems: Vec<_> = local
+            .query_filtered::<Entity, Or<(With<Nodes>, With<hooke::springs::Spring>)>>()
             .iter(&local)
             .collect();
-        for s in springs {
+        for e in systems {
             local
-                .entity_mut(s)
+                .entity_mut(e)
                 .insert(LocalSubsteps::try_new(n).unwrap());
         }
         let mut bdf2 = world(4);
         bdf2.insert_resource(StabilityPolicy::SwitchToImplicit(ImplicitScheme::Bdf2));
-        stiff_rope20(&mut bdf2);
+        spawn(&mut bdf2);
         for _ in 0..30 {
             local.step_physics();
             bdf2.step_physics();
         }
         let (ours, reference) = compare(cfg, || local.step_physics(), || bdf2.step_physics());
         line(
-            &format!("local_substeps_{n}_vs_bdf2_rope20"),
+            &format!("local_substeps_{n}_vs_bdf2_{tag}"),
             ours,
             reference,
             &format!(
-                "the stiff rope stepped {n} times per substep on its own vs solved by BDF2 (the automatic policy's crossover is {})",
-                hooke::integrator::stability::LOCAL_SUBSTEPS_CHEAPER_UP_TO
+                "stepped {n} times per substep on its own vs solved by BDF2 (the automatic policy's crossover is {})",
+                crossover()
             ),
         );
     }

@@ -19,16 +19,16 @@
 //!
 //! - **[`Rescue::LocalSubsteps`]**: the system alone is stepped explicitly n times per substep
 //!   (h/n < h_crit), everything else once. Exact symplectic Euler at a finer step: no
-//!   numerical damping, and cheaper than a Newton solve while n is below about 70 (a stiff
-//!   rope of twenty beads needs 9 and costs a third of BDF2; a top on a stiff pivot needs 8). Chosen for spring systems (meshes and
-//!   the entity springs) while n ≤ [`LOCAL_SUBSTEPS_CHEAPER_UP_TO`], the count below which it
-//!   measures cheaper than BDF2 (`examples/perf_report`, `rescue_*` lines), and for springs
-//!   anchored off a rigid body's centre up to [`MAX_LOCAL_SUBSTEPS`], because their implicit
-//!   alternative, backward Euler, takes a spinning top's spin.
-//! - **[`Rescue::Implicit`]**`(`[`ImplicitScheme::Bdf2`]`)`: past that count, and for soft
-//!   bodies. Stable at any stiffness; it damps only the motions too fast for the step: a
-//!   pendulum on a stiff rod keeps its swing, a taut string its tone. One Newton solve per
-//!   substep.
+//!   numerical damping, and cheaper than a Newton solve while n is small (a stiff rope of
+//!   twenty beads needs 9 and costs a third of BDF2; a top on a stiff pivot needs 8). Chosen
+//!   while n is at most the count up to which each effect measured it cheaper than its BDF2
+//!   solve (spring systems and soft bodies; `examples/perf_report`, `local_substeps_*`
+//!   lines), and for springs anchored off a rigid body's centre up to
+//!   [`MAX_LOCAL_SUBSTEPS`], because their implicit alternative, backward Euler, takes a
+//!   spinning top's spin.
+//! - **[`Rescue::Implicit`]**`(`[`ImplicitScheme::Bdf2`]`)`: past that count. Stable at any
+//!   stiffness; it damps only the motions too fast for the step: a pendulum on a stiff rod
+//!   keeps its swing, a taut string its tone. One Newton solve per substep.
 //! - **[`Rescue::Implicit`]**`(`[`ImplicitScheme::BackwardEuler`]`)`, last: springs anchored off
 //!   a body's centre that need more than [`MAX_LOCAL_SUBSTEPS`] (BDF2's position correction
 //!   cannot turn a body). It damps every motion.
@@ -45,12 +45,6 @@
 use bevy_ecs::prelude::*;
 
 use super::{ImplicitScheme, Integrator};
-
-/// Local substeps per substep at most that [`StabilityPolicy::Automatic`] takes before it
-/// solves a spring system by BDF2 instead: measured, BDF2's Newton solve costs about as much
-/// as 70 local substeps of the same springs (a 20-bead rope: 9 local substeps cost 0.34 of
-/// BDF2, 64 cost 0.92; `examples/perf_report`, `local_substeps_*` lines).
-pub const LOCAL_SUBSTEPS_CHEAPER_UP_TO: u32 = 64;
 
 /// Local substeps per substep at most for springs anchored off a rigid body's centre, whose
 /// only implicit rescue, backward Euler, damps the body's spin; past it, backward Euler.
@@ -97,9 +91,12 @@ impl Rescue {
 /// What a system past its limit offers the policy.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct RescueOptions {
-    /// Local substeps per substep that would keep it stable, if it can be stepped on its own
-    /// (spring systems can; soft bodies cannot yet).
+    /// Local substeps per substep that would keep it stable, if it can be stepped on its own.
     pub local_substeps: Option<u32>,
+    /// Up to how many local substeps per substep cost less than its implicit solve (each
+    /// effect measures its own: `springs::stability::LOCAL_SUBSTEPS_CHEAPER_UP_TO`,
+    /// `soft::stability::LOCAL_SUBSTEPS_CHEAPER_UP_TO`).
+    pub cheaper_up_to: u32,
     /// Whether BDF2 is out: springs anchored off a rigid body's centre, whose correction
     /// would have to turn the body.
     pub no_bdf2: bool,
@@ -127,7 +124,7 @@ impl StabilityPolicy {
                 let cap = if options.no_bdf2 {
                     MAX_LOCAL_SUBSTEPS
                 } else {
-                    LOCAL_SUBSTEPS_CHEAPER_UP_TO
+                    options.cheaper_up_to.min(MAX_LOCAL_SUBSTEPS)
                 };
                 Some(match options.local_substeps {
                     Some(n) if n <= cap => Rescue::LocalSubsteps(n.max(2)),
@@ -145,6 +142,7 @@ impl StabilityPolicy {
             method,
             RescueOptions {
                 local_substeps: None,
+                cheaper_up_to: 0,
                 no_bdf2: false,
             },
         ) {
@@ -202,6 +200,54 @@ impl LocalSubsteps {
     pub fn count(self) -> u32 {
         self.count
     }
+}
+
+/// Puts `rescue` on a system's entity, replacing the other kind of rescue if it had one.
+pub(crate) fn put_rescue(commands: &mut Commands, e: Entity, rescue: Rescue) {
+    match rescue {
+        Rescue::LocalSubsteps(n) => {
+            if let Ok(local) = LocalSubsteps::try_new(n) {
+                commands.entity(e).insert(local);
+            }
+        }
+        Rescue::Implicit(scheme) => {
+            commands
+                .entity(e)
+                .remove::<LocalSubsteps>()
+                .insert(super::ImplicitEuler::solved_by(scheme));
+        }
+    }
+}
+
+/// `count` symplectic-Euler steps of `h / count` on a mesh: `add_forces` adds its own
+/// forces to `nodes.f` at each step's state (false if they came out non-finite), on top of the
+/// other forces, held from the substep's start. Pinned nodes move at their velocity.
+/// `held` is scratch. The mesh's local substeps ([`LocalSubsteps`]); false on non-finite
+/// forces.
+pub(crate) fn step_locally(
+    nodes: &mut crate::particles::Nodes,
+    count: u32,
+    h: f32,
+    held: &mut Vec<glam::Vec3A>,
+    mut add_forces: impl FnMut(&mut crate::particles::Nodes) -> bool,
+) -> bool {
+    let hs = h / count as f32;
+    held.clear();
+    held.extend_from_slice(&nodes.f);
+    for _ in 0..count {
+        nodes.f.copy_from_slice(held);
+        if !add_forces(nodes) {
+            return false;
+        }
+        let crate::particles::Nodes {
+            x, v, f, inv_mass, ..
+        } = nodes;
+        for i in 0..x.len() {
+            v[i] += (hs * inv_mass[i]) * f[i];
+            x[i] += hs * v[i];
+        }
+    }
+    true
 }
 
 /// Local substeps per substep of `substep` (s) that keep a system of limit `h_crit` stable,

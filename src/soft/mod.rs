@@ -175,6 +175,10 @@ pub struct SoftBody {
     contact_thickness: f32,
     /// The contacts of the last substep, for the implicit solve to respect.
     contacts: Vec<NodeContact>,
+    /// Whether its nodes have pressed on a dynamic body: its local substeps (a rescue) then
+    /// give way to BDF2, whose solve takes the body's response with the contact.
+    #[serde(default)]
+    pub(crate) touched_a_body: bool,
 }
 
 /// Adds an element's nodal forces: the columns of H = −V P Dm⁻ᵀ to corners 1..3, their
@@ -203,6 +207,10 @@ impl crate::collision::nodes::NodeLayer for SoftBody {
 
     fn contacts_mut(&mut self) -> &mut Vec<NodeContact> {
         &mut self.contacts
+    }
+
+    fn touched_a_body(&mut self) {
+        self.touched_a_body = true;
     }
 }
 
@@ -246,6 +254,7 @@ impl SoftBody {
             stats: SoftBodyStats::default(),
             contact_thickness: 0.005,
             contacts: Vec::new(),
+            touched_a_body: false,
         };
         Ok((nodes, body))
     }

@@ -12,7 +12,7 @@ use crate::core::schedule::{
     add_own_force_systems, add_own_systems,
 };
 use crate::core::time::SubstepTime;
-use crate::integrator::{ImplicitEuler, ImplicitState};
+use crate::integrator::{ImplicitEuler, ImplicitState, LocalSubsteps};
 use crate::particles::Nodes;
 
 /// Elastic forces of [`SoftBody`] meshes. Its systems run only while a soft body exists.
@@ -30,11 +30,15 @@ impl WorldPlugin for SoftBodyPlugin {
                 .run_if(any_with_component::<SoftBody>)
                 .in_set(ForceSystems::Elasticity)
         });
+        crate::core::whole_step::block_on::<LocalSubsteps>(world);
         add_own_systems(
             world,
             SubstepSchedule,
-            solve_implicit
-                .run_if(any_with_component::<ImplicitEuler>)
+            (
+                solve_implicit.run_if(any_with_component::<ImplicitEuler>),
+                substep_soft_bodies.run_if(any_with_component::<LocalSubsteps>),
+            )
+                .chain()
                 .in_set(crate::core::schedule::ImplicitSystems::SoftBodies),
         );
         // Attachments first (chained: both move nodes), so that the contacts have the last
@@ -79,7 +83,7 @@ impl WorldPlugin for SoftBodyPlugin {
 /// f += −V P(F) Dm⁻ᵀ per tetrahedron; a body whose forces come out non-finite is quarantined.
 fn apply_elastic_forces(
     mut commands: Commands,
-    mut bodies: Query<(Entity, &mut Nodes, &mut SoftBody), (Simulated, Without<ImplicitEuler>)>,
+    mut bodies: Query<(Entity, &mut Nodes, &mut SoftBody), ExplicitSoft>,
 ) {
     for (e, mut nodes, mut body) in &mut bodies {
         let n = nodes.bypass_change_detection();
@@ -90,6 +94,40 @@ fn apply_elastic_forces(
             commands.entity(e).insert(Quarantined {
                 reason: QuarantineReason::NonFiniteState,
             });
+        }
+    }
+}
+
+/// Soft bodies the explicit integrators advance.
+type ExplicitSoft = (Simulated, Without<ImplicitEuler>, Without<LocalSubsteps>);
+
+/// What the local steps of a soft body use.
+type LocalSoft<'a> = (Entity, &'a mut Nodes, &'a mut SoftBody, &'a LocalSubsteps);
+
+/// Steps each soft body with [`LocalSubsteps`] (and no [`ImplicitEuler`]) n times per
+/// substep on its own: its elastic and damping forces recomputed at each local step, the
+/// other forces on its nodes held (see [`crate::integrator::stability`]).
+fn substep_soft_bodies(
+    mut commands: Commands,
+    guard: Res<crate::core::quarantine::DivergenceGuard>,
+    time: Res<SubstepTime>,
+    mut bodies: Query<LocalSoft, (Simulated, Without<ImplicitEuler>)>,
+    mut held: Local<Vec<glam::Vec3A>>,
+) {
+    for (e, mut nodes, mut body, local) in &mut bodies {
+        let n = nodes.bypass_change_detection();
+        let body = body.bypass_change_detection();
+        let ok =
+            crate::integrator::stability::step_locally(n, local.count(), time.h, &mut held, |n| {
+                body.accumulate(&n.x, &n.v, &n.mass, &mut n.f)
+            });
+        let reason = if ok && n.is_finite() {
+            crate::integrator::mesh_divergence(n, &guard)
+        } else {
+            Some(QuarantineReason::NonFiniteState)
+        };
+        if let Some(reason) = reason {
+            commands.entity(e).insert(Quarantined { reason });
         }
     }
 }

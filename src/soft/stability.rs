@@ -14,8 +14,9 @@
 //! near its limit is solved implicitly rather than risked.
 //!
 //! A [`SoftBody`] integrated explicitly past its limit is handled by
-//! [`crate::integrator::StabilityPolicy`] (by default solved by BDF2 from then on), told once
-//! by a [`StabilityWarning`].
+//! [`crate::integrator::StabilityPolicy`], told once by a [`StabilityWarning`]: by default
+//! stepped on its own a few times per substep ([`LocalSubsteps`]) while that is cheaper than
+//! its implicit solve ([`LOCAL_SUBSTEPS_CHEAPER_UP_TO`]), solved by BDF2 beyond.
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
@@ -24,8 +25,16 @@ use super::SoftBody;
 use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::quarantine::Quarantined;
 use crate::core::time::PhysicsTime;
-use crate::integrator::stability::{StabilityPolicy, StabilityWarning, critical_step, tell};
+use crate::integrator::stability::{
+    LocalSubsteps, RescueOptions, StabilityPolicy, StabilityWarning, critical_step,
+    local_substeps_needed, put_rescue, tell,
+};
 use crate::integrator::{ImplicitEuler, Integrator, IntegratorOverride};
+
+/// Local substeps per substep at most that [`StabilityPolicy::Automatic`] takes for a soft
+/// body before it solves it by BDF2 instead: the count at which they cost about what BDF2's
+/// Newton solve does (`examples/perf_report`, `local_substeps_*_softbar480` lines).
+pub const LOCAL_SUBSTEPS_CHEAPER_UP_TO: u32 = 12;
 
 /// A soft body's explicit stability limit (see the module docs); added with [`SoftBody`].
 #[derive(
@@ -72,6 +81,7 @@ pub(crate) fn check_soft_stability(
             &mut SoftStability,
             Has<ImplicitEuler>,
             Option<&IntegratorOverride>,
+            Option<&LocalSubsteps>,
         ),
         Without<Quarantined>,
     >,
@@ -81,33 +91,57 @@ pub(crate) fn check_soft_stability(
     let policy = policy.map_or_else(StabilityPolicy::default, |p| *p);
     let substep = time.dt() / time.substeps() as f32;
     let mut smallest = f32::INFINITY;
-    for (e, body, mut stability, implicit, o) in &mut bodies {
-        if !stability.computed || body.is_changed() {
+    for (e, body, mut stability, implicit, o, local) in &mut bodies {
+        let fresh = !stability.computed || body.is_changed();
+        if fresh {
             stability.critical_step = body.critical_step();
             stability.computed = true;
         }
         smallest = smallest.min(stability.critical_step);
         let method = o.map_or(*global, |o| o.0);
-        if implicit
-            || method == Integrator::ImplicitEuler
-            || stability.warned
-            || substep <= stability.critical_step
-        {
+        if implicit || method == Integrator::ImplicitEuler {
             continue;
         }
-        stability.warned = true;
-        let rescue = policy.rescue(method);
-        if let Some(scheme) = rescue {
-            commands.entity(e).insert(ImplicitEuler::solved_by(scheme));
+        let options = RescueOptions {
+            local_substeps: Some(local_substeps_needed(substep, stability.critical_step)),
+            cheaper_up_to: LOCAL_SUBSTEPS_CHEAPER_UP_TO,
+            no_bdf2: false,
+        };
+        match local {
+            // Rescued by local substeps: re-decided (silently) if its material changed past
+            // what its count holds, and solved by BDF2 once it presses on a dynamic body
+            // (which takes its impulses once per substep, not per local step: the body would
+            // sink into it by millimetres).
+            Some(_) if body.touched_a_body => {
+                let bdf2 =
+                    crate::integrator::Rescue::Implicit(crate::integrator::ImplicitScheme::Bdf2);
+                if policy.choose(method, options).is_some() {
+                    put_rescue(&mut commands, e, bdf2);
+                }
+            }
+            Some(l) if fresh && substep / l.count() as f32 > stability.critical_step => {
+                if let Some(rescue) = policy.choose(method, options) {
+                    put_rescue(&mut commands, e, rescue);
+                }
+            }
+            Some(_) => {}
+            None if !stability.warned && substep > stability.critical_step => {
+                stability.warned = true;
+                let rescue = policy.choose(method, options);
+                if let Some(rescue) = rescue {
+                    put_rescue(&mut commands, e, rescue);
+                }
+                tell(
+                    &mut warnings,
+                    diag.as_deref_mut(),
+                    e,
+                    stability.critical_step,
+                    (time.dt(), substep),
+                    rescue,
+                );
+            }
+            None => {}
         }
-        tell(
-            &mut warnings,
-            diag.as_deref_mut(),
-            e,
-            stability.critical_step,
-            (time.dt(), substep),
-            rescue.map(crate::integrator::Rescue::Implicit),
-        );
     }
     if let Some(d) = diag.as_mut() {
         d.soft_critical_step = smallest;

@@ -368,22 +368,9 @@ pub(crate) fn substep_meshes(
             commands.entity(e).insert(Quarantined { reason });
             continue;
         }
-        let steps = local.count();
-        let hs = time.h / steps as f32;
-        let f_ext = &mut *scratch;
-        f_ext.clear();
-        f_ext.extend_from_slice(&n.f);
-        for _ in 0..steps {
-            n.f.copy_from_slice(f_ext);
-            network.accumulate(n);
-            let Nodes {
-                x, v, f, inv_mass, ..
-            } = &mut *n;
-            for i in 0..x.len() {
-                v[i] += (hs * inv_mass[i]) * f[i];
-                x[i] += hs * v[i];
-            }
-        }
+        crate::integrator::stability::step_locally(n, local.count(), time.h, &mut scratch, |n| {
+            network.accumulate(n)
+        });
         let reason = if n.is_finite() {
             crate::integrator::mesh_divergence(n, &guard)
         } else {

@@ -32,10 +32,16 @@ use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::time::PhysicsTime;
 use crate::integrator::stability::{
     LocalSubsteps, Rescue, RescueOptions, StabilityPolicy, StabilityWarning, critical_step,
-    local_substeps_needed, tell,
+    local_substeps_needed, put_rescue, tell,
 };
 use crate::integrator::{ImplicitEuler, Integrator, IntegratorOverride};
 use crate::particles::{Mass, Nodes};
+
+/// Local substeps per substep at most that [`StabilityPolicy::Automatic`] takes for a spring
+/// system before it solves it by BDF2 instead: measured, BDF2's Newton solve costs about as
+/// much as 70 local substeps of the same springs (a 20-bead rope: 9 local substeps cost 0.34
+/// of BDF2, 64 cost 0.92; `examples/perf_report`, `local_substeps_*` lines).
+pub const LOCAL_SUBSTEPS_CHEAPER_UP_TO: u32 = 64;
 
 /// A [`SpringNetwork`] mesh's explicit stability limit (see the module docs).
 #[derive(
@@ -104,23 +110,6 @@ fn best_limit(rows: &HashMap<(Entity, [u32; 3]), (f32, f32)>) -> f32 {
     limit(rows.values().copied())
 }
 
-/// Puts `rescue` on a mesh or spring (replacing the other kind, if any).
-fn put(commands: &mut Commands, e: Entity, rescue: Rescue) {
-    match rescue {
-        Rescue::LocalSubsteps(n) => {
-            if let Ok(local) = LocalSubsteps::try_new(n) {
-                commands.entity(e).insert(local);
-            }
-        }
-        Rescue::Implicit(scheme) => {
-            commands
-                .entity(e)
-                .remove::<LocalSubsteps>()
-                .insert(ImplicitEuler::solved_by(scheme));
-        }
-    }
-}
-
 /// Recomputes the limits that springs or masses changed, and warns once per system past it
 /// (switching it to an implicit scheme as [`StabilityPolicy`] says).
 #[allow(clippy::type_complexity, clippy::too_many_arguments)] // the change filters are the point
@@ -178,6 +167,7 @@ pub(crate) fn check_stability(
         }
         let options = RescueOptions {
             local_substeps: Some(local_substeps_needed(substep, stability.critical_step)),
+            cheaper_up_to: LOCAL_SUBSTEPS_CHEAPER_UP_TO,
             no_bdf2: false,
         };
         match local {
@@ -185,7 +175,7 @@ pub(crate) fn check_stability(
             // changed past what its count holds.
             Some(l) if fresh && substep / l.count() as f32 > stability.critical_step => {
                 if let Some(rescue) = policy.choose(o.map_or(global, |o| o.0), options) {
-                    put(&mut commands, e, rescue);
+                    put_rescue(&mut commands, e, rescue);
                 }
             }
             Some(_) => {}
@@ -193,7 +183,7 @@ pub(crate) fn check_stability(
                 stability.warned = true;
                 let rescue = policy.choose(o.map_or(global, |o| o.0), options);
                 if let Some(rescue) = rescue {
-                    put(&mut commands, e, rescue);
+                    put_rescue(&mut commands, e, rescue);
                 }
                 warn(e, stability.critical_step, rescue, &mut diag);
             }
@@ -251,6 +241,7 @@ pub(crate) fn check_stability(
             Integrator::SymplecticEuler,
             RescueOptions {
                 local_substeps: Some(local_substeps_needed(substep, best_limit(&rows))),
+                cheaper_up_to: LOCAL_SUBSTEPS_CHEAPER_UP_TO,
                 no_bdf2: levered,
             },
         );
@@ -292,7 +283,7 @@ pub(crate) fn check_stability(
         }
         if let Some(rescue) = rescue {
             for e in stiff {
-                put(&mut commands, e, rescue);
+                put_rescue(&mut commands, e, rescue);
             }
         }
     }

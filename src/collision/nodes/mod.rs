@@ -81,6 +81,8 @@ pub(crate) trait NodeLayer: Component<Mutability = bevy_ecs::component::Mutable>
     fn thickness(&self) -> f32;
     /// The contacts found this substep.
     fn contacts_mut(&mut self) -> &mut Vec<ContactPlane>;
+    /// Told when its nodes press on a dynamic body.
+    fn touched_a_body(&mut self) {}
 }
 
 type Mesh<'a, L> = (
@@ -179,6 +181,7 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
             match rigid.as_mut() {
                 Some(side) if side.dynamic => {
                     push_dynamic(n, side, &hits, factor, friction.0, h);
+                    body.touched_a_body();
                 }
                 other => {
                     let side = other.map(|s| &*s);

@@ -269,6 +269,7 @@ fn every_substep_system_is_replicated_or_blocks_the_path() {
         "hooke::springs::implicit::solve_implicit_springs", // SpringNetwork, ImplicitEuler
         "hooke::soft::plugin::apply_elastic_forces", // SoftBody
         "hooke::soft::plugin::solve_implicit",       // SoftBody, ImplicitEuler
+        "hooke::soft::plugin::substep_soft_bodies",  // SoftBody, LocalSubsteps
         "hooke::soft::attach::solve_attachments",    // NodeAttachments
         "hooke::collision::nodes::collide_nodes<hooke::soft::SoftBody>", // SoftBody
         "hooke::collision::nodes::coupling::apply_node_impulses", // NodeImpulse

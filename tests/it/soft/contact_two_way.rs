@@ -225,3 +225,26 @@ fn a_jelly_dropped_on_a_crate_on_the_ground_comes_to_rest_on_it() {
         );
     }
 }
+
+#[test]
+fn a_soft_body_stepped_on_its_own_is_solved_by_bdf2_once_it_presses_on_a_dynamic_body() {
+    // At 8 substeps the E = 1e5 cube is past its (safe) limit: the policy steps it 3 times
+    // per substep on its own while it falls, and solves it by BDF2 once it lands on the
+    // platform, whose impulses it takes once per substep (with local steps in between the
+    // cube would sink 0.7 mm into it).
+    let (mut w, _, soft, _, _) = platform_scene(false);
+    w.step_physics();
+    assert_eq!(
+        w.get::<hooke::integrator::LocalSubsteps>(soft)
+            .map(|l| l.count()),
+        Some(3)
+    );
+    for _ in 0..15 {
+        w.step_physics();
+    }
+    assert!(w.get::<hooke::integrator::LocalSubsteps>(soft).is_none());
+    assert_eq!(
+        w.get::<ImplicitEuler>(soft).map(|s| s.scheme),
+        Some(hooke::integrator::ImplicitScheme::Bdf2)
+    );
+}
