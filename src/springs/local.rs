@@ -103,6 +103,7 @@ pub(crate) type LocalBody<'a> = (
     &'a crate::particles::LinearVelocity,
     &'a Mass,
     Option<&'a crate::integrator::IntegratorOverride>,
+    Has<crate::core::rest::Sleeping>,
 );
 
 /// What it reads of a turning body.
@@ -130,7 +131,9 @@ impl LocalSolve {
         if let Some(&i) = self.index.get(&e) {
             return Some(i);
         }
-        let (x, v, m, _) = bodies.get(e).ok()?;
+        let (x, v, m, _, asleep) = bodies.get(e).ok()?;
+        // A sleeping body is held where it is, as a pin: its own integrator skips it.
+        let held = m.is_pinned() || asleep;
         let turning = turning.get(e).ok().map(|(q, w, l, inertia)| Turning {
             q0: q.0,
             q: q.0,
@@ -144,8 +147,8 @@ impl LocalSolve {
         self.index.insert(e, i);
         self.bodies.push(Body {
             entity: e,
-            m: if m.is_pinned() { 0.0 } else { m.value() },
-            w: m.inverse(),
+            m: if held { 0.0 } else { m.value() },
+            w: if held { 0.0 } else { m.inverse() },
             x0: x.0,
             v0: v.0,
             x: x.0,
@@ -260,7 +263,7 @@ pub(crate) fn substep_entity_springs(
         let accepts = |e: Entity| {
             bodies
                 .get(e)
-                .is_ok_and(|(_, _, m, o)| super::entity_implicit::end_accepts(global, m, o))
+                .is_ok_and(|(_, _, m, o, _)| super::entity_implicit::end_accepts(global, m, o))
         };
         if !(accepts(spring.a) && accepts(spring.b)) {
             continue;
