@@ -94,6 +94,17 @@ pub enum Error {
         /// The count given.
         got: usize,
     },
+    /// A count past its documented bound (substeps per step, steps per frame, cells, ...):
+    /// refused before anything is allocated or run.
+    #[error("{what} may be at most {max}, got {got}")]
+    TooMany {
+        /// What was counted, e.g. `"substeps per step"`.
+        what: &'static str,
+        /// The largest accepted count.
+        max: u64,
+        /// The count given.
+        got: u64,
+    },
     /// A shape has no volume (flat, open or a heightfield), so it has no mass to simulate.
     #[error("shape {0} has no volume, so it has no mass; give explicit mass properties")]
     ZeroVolume(String),

@@ -101,7 +101,8 @@ pub struct DivergenceGuard {
     /// Speed beyond any body's in a game (m/s; default 1e4, ten times a rifle bullet's).
     pub max_speed: f32,
     /// Spring strain |l − r| / r beyond any rope's (dimensionless; default 100: a spring
-    /// stretched to 101 times its rest length). Zero-length springs are not checked.
+    /// stretched to 101 times its rest length). Zero-length springs and dampers (k = 0) are
+    /// not checked: neither has a length to keep.
     pub max_spring_strain: f32,
     /// Distance from the origin along any axis beyond any game world's (m; default 1e6,
     /// [`crate::collision::Collider::MAX_EXTENT`]: f32 resolves positions there to 6 cm). Checked

@@ -10,8 +10,10 @@ use bevy_ecs::prelude::*;
 
 use crate::core::error::{Error, Result};
 
-/// The fixed step and the simulation clock.
+/// The fixed step and the simulation clock. Read from a file (a snapshot), it is checked as
+/// [`PhysicsTime::new`] checks its input.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone)]
+#[serde(try_from = "TimeRecord")]
 pub struct PhysicsTime {
     dt: f32,
     substeps: u32,
@@ -37,18 +39,70 @@ impl Default for PhysicsTime {
     }
 }
 
+/// [`PhysicsTime`] as a file holds it, checked on the way in.
+#[derive(serde::Deserialize)]
+struct TimeRecord {
+    dt: f32,
+    substeps: u32,
+    max_steps_per_frame: u32,
+    accumulator: f32,
+    elapsed: f64,
+    steps: u64,
+}
+
+impl TryFrom<TimeRecord> for PhysicsTime {
+    type Error = Error;
+
+    fn try_from(r: TimeRecord) -> Result<Self> {
+        let time =
+            PhysicsTime::new(r.dt, r.substeps)?.with_max_steps_per_frame(r.max_steps_per_frame)?;
+        if !(r.accumulator.is_finite() && r.accumulator >= 0.0) {
+            return Err(Error::NonFinite {
+                what: "time accumulator",
+                value: r.accumulator.to_string(),
+            });
+        }
+        if !r.elapsed.is_finite() {
+            return Err(Error::NonFinite {
+                what: "elapsed time",
+                value: r.elapsed.to_string(),
+            });
+        }
+        Ok(Self {
+            accumulator: r.accumulator,
+            elapsed: r.elapsed,
+            steps: r.steps,
+            ..time
+        })
+    }
+}
+
 impl PhysicsTime {
+    /// The most substeps a step may be split into: 4096 (h = 4 µs at 60 Hz). A count past
+    /// it would make a step take minutes, or never return.
+    pub const MAX_SUBSTEPS: u32 = 4096;
+
+    /// The most steps one frame may catch up on: 1024.
+    pub const MAX_STEPS_PER_FRAME: u32 = 1024;
+
     /// A fixed step of `dt` seconds split into `substeps` substeps.
     ///
     /// # Errors
     /// [`Error::InvalidTimeStep`] if `dt` is not positive and finite, [`Error::ZeroSubsteps`]
-    /// if `substeps` is 0.
+    /// if `substeps` is 0, [`Error::TooMany`] past [`PhysicsTime::MAX_SUBSTEPS`].
     pub fn new(dt: f32, substeps: u32) -> Result<Self> {
         if !(dt.is_finite() && dt > 0.0) {
             return Err(Error::InvalidTimeStep(dt));
         }
         if substeps == 0 {
             return Err(Error::ZeroSubsteps);
+        }
+        if substeps > Self::MAX_SUBSTEPS {
+            return Err(Error::TooMany {
+                what: "substeps per step",
+                max: Self::MAX_SUBSTEPS.into(),
+                got: substeps.into(),
+            });
         }
         Ok(Self {
             dt,
@@ -57,16 +111,24 @@ impl PhysicsTime {
         })
     }
 
-    /// Caps how many steps one call to `advance_physics` may run (at least 1).
+    /// Caps how many steps one call to `advance_physics` may run (1 to
+    /// [`PhysicsTime::MAX_STEPS_PER_FRAME`]).
     ///
     /// # Errors
-    /// [`Error::TooFew`] for 0.
+    /// [`Error::TooFew`] for 0, [`Error::TooMany`] past the bound.
     pub fn with_max_steps_per_frame(mut self, max: u32) -> Result<Self> {
         if max == 0 {
             return Err(Error::TooFew {
                 what: "steps per frame",
                 min: 1,
                 got: 0,
+            });
+        }
+        if max > Self::MAX_STEPS_PER_FRAME {
+            return Err(Error::TooMany {
+                what: "steps per frame",
+                max: Self::MAX_STEPS_PER_FRAME.into(),
+                got: max.into(),
             });
         }
         self.max_steps_per_frame = max;

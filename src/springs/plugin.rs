@@ -188,22 +188,24 @@ fn apply_spring_forces(
         let (pa, va, ra) = anchor_state(ea, spin(s.a, s.anchor_a), s.anchor_a);
         let (pb, vb, rb) = anchor_state(eb, spin(s.b, s.anchor_b), s.anchor_b);
         let f = spring_force(pa, pb, va, vb, s.rest_length, s.stiffness, s.damping);
-        // A force past the guard's strain (|f| > k r s_max, damping included) or not finite
+        // A stretch past the guard's strain (|l − r| > s_max r) or a force that is not finite
         // means the integration diverged: both ends leave, with the spring named, instead
-        // of the force being dropped silently.
-        let limit = s.stiffness * s.rest_length * guard.max_spring_strain;
+        // of the force being dropped silently. The strain, not the force: a damper's force
+        // (c v) says nothing of divergence, and a soft door spring (k = 1, c = 50) or a pure
+        // damper (k = 0) pushed hard is no runaway. A damper alone has no strain to keep.
         let ends_finite = pa.is_finite() && pb.is_finite() && va.is_finite() && vb.is_finite();
         if !ends_finite {
             // A non-finite end (written by game code, say) is caught and named by the state
             // check after integration; its neighbours must not catch its NaN meanwhile.
             continue;
         }
-        if !f.is_finite() || (s.rest_length > 0.0 && f.length_squared() > limit * limit) {
-            let strain = if f.is_finite() {
-                ((pb - pa).length() - s.rest_length) / s.rest_length
-            } else {
-                f32::NAN
-            };
+        let strain = if s.rest_length > 0.0 && s.stiffness > 0.0 {
+            ((pb - pa).length() - s.rest_length) / s.rest_length
+        } else {
+            0.0
+        };
+        if !f.is_finite() || strain.abs() > guard.max_spring_strain {
+            let strain = if f.is_finite() { strain } else { f32::NAN };
             // A pinned end (a hook in the ceiling) did not diverge and stays.
             for end in [s.a, s.b]
                 .into_iter()

@@ -144,8 +144,15 @@ pub(super) fn load(src: &str, file: &str) -> Result<Scenario, ScenarioError> {
             ),
         ));
     }
-    if settings.substeps == 0 {
-        return Err(bad(1, "settings.substeps must be at least 1".into()));
+    if settings.substeps == 0 || settings.substeps > crate::core::time::PhysicsTime::MAX_SUBSTEPS {
+        return Err(bad(
+            1,
+            format!(
+                "settings.substeps must be 1 to {}, got {}",
+                crate::core::time::PhysicsTime::MAX_SUBSTEPS,
+                settings.substeps
+            ),
+        ));
     }
     if !settings.gravity.is_finite() {
         return Err(bad(

@@ -2,6 +2,7 @@
 
 mod bad_input;
 mod bad_input_caught;
+mod bounded_clock;
 mod fuzz;
 mod fuzz_findings;
 mod harness;

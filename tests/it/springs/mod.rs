@@ -1,6 +1,7 @@
 //! Springs, chains and spring meshes: forces, stability limits, warnings and the implicit solves.
 
 mod chain;
+mod dampers_are_not_runaways;
 mod damping_limit;
 mod default_builders_stable;
 mod force_law_and_chains;
