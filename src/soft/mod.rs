@@ -268,6 +268,11 @@ impl SoftBody {
             && self.contacts.iter().all(|c| (c.node as usize) < nodes)
     }
 
+    /// The largest node index its elements name (None without elements).
+    pub(crate) fn largest_node(&self) -> Option<u32> {
+        self.tets.iter().flatten().copied().max()
+    }
+
     /// How far from a collider's surface its nodes are kept (m; default 5 mm).
     ///
     /// # Errors

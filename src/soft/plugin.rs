@@ -60,6 +60,7 @@ impl WorldPlugin for SoftBodyPlugin {
             world,
             PhysicsSchedule,
             (
+                refuse_misfit_bodies.run_if(any_with_component::<SoftBody>),
                 crate::integrator::follow_implicit_dial::<SoftBody>
                     .run_if(any_with_component::<SoftBody>),
                 super::targets::drive_node_targets.run_if(any_with_component::<super::NodeTargets>),
@@ -93,6 +94,35 @@ fn apply_elastic_forces(
         if !ok {
             commands.entity(e).insert(Quarantined {
                 reason: QuarantineReason::NonFiniteState,
+            });
+        }
+    }
+}
+
+/// A soft body whose `Nodes` or elements game code changed is checked before anything
+/// indexes them: nodes emptied or cut short under the elements, or elements of a bigger mesh
+/// put on a smaller one, quarantine the body, named, instead of indexing out of bounds. A
+/// consistent replacement (new nodes and elements together) is adopted: the implicit solve
+/// rebuilds its factor for the new sizes.
+fn refuse_misfit_bodies(
+    mut commands: Commands,
+    bodies: Query<(Entity, Ref<Nodes>, Ref<SoftBody>), Without<Quarantined>>,
+) {
+    for (e, nodes, body) in &bodies {
+        if !(nodes.is_changed() || body.is_changed()) {
+            continue;
+        }
+        let len = nodes.len();
+        if !nodes.consistent() || !body.fits(len) {
+            let index = body.largest_node().map_or(0, |i| i as usize);
+            commands.entity(e).insert(Quarantined {
+                reason: QuarantineReason::InvalidInput(
+                    crate::core::error::Error::IndexOutOfRange {
+                        what: "soft body element node",
+                        index,
+                        len,
+                    },
+                ),
             });
         }
     }

@@ -4,6 +4,7 @@ mod attach;
 mod contact_two_way;
 mod implicit;
 mod mesh_files;
+mod meshes_changed_mid_run;
 mod soft_body;
 mod stable_at_the_defaults;
 mod strain;
