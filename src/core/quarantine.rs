@@ -95,8 +95,10 @@ impl core::fmt::Display for QuarantineReason {
 }
 
 /// When a finite state counts as diverged (see the module docs). Set a field to
-/// `f32::INFINITY` to turn that check off.
+/// `f32::INFINITY` to turn that check off. Read from a file (a snapshot), every limit must be
+/// positive and not NaN (a NaN limit would turn its check off unseen).
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
+#[serde(try_from = "GuardRecord")]
 pub struct DivergenceGuard {
     /// Speed beyond any body's in a game (m/s; default 1e4, ten times a rifle bullet's).
     pub max_speed: f32,
@@ -116,6 +118,41 @@ pub struct DivergenceGuard {
     /// held a step for minutes.
     #[serde(default = "spin_limit")]
     pub max_angular_speed: f32,
+}
+
+/// [`DivergenceGuard`] as a file holds it.
+#[derive(serde::Deserialize)]
+struct GuardRecord {
+    max_speed: f32,
+    max_spring_strain: f32,
+    #[serde(default = "far")]
+    max_distance: f32,
+    #[serde(default = "spin_limit")]
+    max_angular_speed: f32,
+}
+
+impl TryFrom<GuardRecord> for DivergenceGuard {
+    type Error = crate::core::error::Error;
+
+    fn try_from(r: GuardRecord) -> crate::core::error::Result<Self> {
+        for (what, value) in [
+            ("guard max_speed", r.max_speed),
+            ("guard max_spring_strain", r.max_spring_strain),
+            ("guard max_distance", r.max_distance),
+            ("guard max_angular_speed", r.max_angular_speed),
+        ] {
+            // Infinity turns a check off on purpose; NaN would do it unseen.
+            if value.is_nan() || value <= 0.0 {
+                return Err(crate::core::error::Error::NotPositive { what, value });
+            }
+        }
+        Ok(Self {
+            max_speed: r.max_speed,
+            max_spring_strain: r.max_spring_strain,
+            max_distance: r.max_distance,
+            max_angular_speed: r.max_angular_speed,
+        })
+    }
 }
 
 fn far() -> f32 {

@@ -166,7 +166,11 @@ impl Integrator {
 /// first order and damps: an undamped oscillator loses the factor 1/(1 + ω²h²) of its energy
 /// per step. Put it on an entity beside the mesh ([`crate::soft::SoftBody`]); the constant
 /// forces of the step (gravity, external, damping) enter as f_ext.
+///
+/// Read from a file (a snapshot), its settings are checked: a tolerance positive and finite,
+/// Newton iterations 1 to 1,000, conjugate-gradient iterations 1 to 100,000.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[serde(try_from = "ImplicitRecord")]
 #[require(ImplicitState)]
 pub struct ImplicitEuler {
     /// Newton stops when the gradient's norm has fallen below this fraction of the step's
@@ -295,6 +299,59 @@ impl Default for ImplicitEuler {
             refactor_after: 1,
             scheme: ImplicitScheme::BackwardEuler,
         }
+    }
+}
+
+/// [`ImplicitEuler`] as a file holds it.
+#[derive(serde::Deserialize)]
+struct ImplicitRecord {
+    tolerance: f32,
+    max_newton: u32,
+    max_cg: u32,
+    max_factor_entries: usize,
+    refactor_after: u32,
+    #[serde(default)]
+    scheme: ImplicitScheme,
+}
+
+impl TryFrom<ImplicitRecord> for ImplicitEuler {
+    type Error = crate::core::error::Error;
+
+    fn try_from(r: ImplicitRecord) -> crate::core::error::Result<Self> {
+        use crate::core::error::Error;
+        if !(r.tolerance.is_finite() && r.tolerance > 0.0) {
+            return Err(Error::NotPositive {
+                what: "implicit solve tolerance",
+                value: r.tolerance,
+            });
+        }
+        for (what, value, max) in [
+            ("Newton iterations", r.max_newton, 1_000),
+            ("conjugate-gradient iterations", r.max_cg, 100_000),
+        ] {
+            if value == 0 {
+                return Err(Error::TooFew {
+                    what,
+                    min: 1,
+                    got: 0,
+                });
+            }
+            if value > max {
+                return Err(Error::TooMany {
+                    what,
+                    max: max.into(),
+                    got: value.into(),
+                });
+            }
+        }
+        Ok(Self {
+            tolerance: r.tolerance,
+            max_newton: r.max_newton,
+            max_cg: r.max_cg,
+            max_factor_entries: r.max_factor_entries,
+            refactor_after: r.refactor_after,
+            scheme: r.scheme,
+        })
     }
 }
 

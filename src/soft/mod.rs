@@ -63,13 +63,34 @@ pub struct Lame {
 
 /// An isotropic elastic material: Young's modulus, Poisson's ratio, density and Rayleigh
 /// damping.
+/// Read from a file (a snapshot) it is checked as [`Material::new`] checks its input.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(try_from = "MaterialRecord")]
 pub struct Material {
     young: f32,
     poisson: f32,
     density: f32,
     mass_damping: f32,
     stiffness_damping: f32,
+}
+
+/// [`Material`] as a file holds it.
+#[derive(serde::Deserialize)]
+struct MaterialRecord {
+    young: f32,
+    poisson: f32,
+    density: f32,
+    mass_damping: f32,
+    stiffness_damping: f32,
+}
+
+impl TryFrom<MaterialRecord> for Material {
+    type Error = Error;
+
+    fn try_from(r: MaterialRecord) -> Result<Self> {
+        Material::new(r.young, r.poisson, r.density)?
+            .with_damping(r.mass_damping, r.stiffness_damping)
+    }
 }
 
 impl Material {

@@ -6,4 +6,5 @@ mod bounded_clock;
 mod fuzz;
 mod fuzz_findings;
 mod harness;
+mod restores_validate;
 mod runaway_velocity_quarantined_first;

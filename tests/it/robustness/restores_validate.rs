@@ -1,0 +1,69 @@
+//! A snapshot from disk is checked as strictly as the constructors check their input: a
+//! soft body's E or ν NaN or −1, a divergence-guard limit NaN (which turned the guard off),
+//! or a NaN solver tolerance were restored without an error.
+
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use hooke::prelude::*;
+use hooke::snapshot::Snapshot;
+use hooke::tools::scenes;
+
+/// An implicit jelly on the ground, stepped once, as RON.
+fn saved() -> String {
+    let mut w = World::new();
+    w.add_physics(PhysicsPlugins);
+    scenes::ground(&mut w).unwrap();
+    scenes::jelly(&mut w, Vec3::new(0.0, 1.0, 0.0), true).unwrap();
+    w.step_physics();
+    Snapshot::capture(&w).unwrap().to_ron().unwrap()
+}
+
+/// `text` with the number after the first `field: ` (after the material's `poisson`, for a
+/// material field) replaced by `value`.
+fn with(text: &str, field: &str, value: &str) -> String {
+    let key = format!("{field}: ");
+    let from = if field == "density" {
+        text.find("poisson: ").unwrap()
+    } else {
+        0
+    };
+    let start = from
+        + text[from..]
+            .find(&key)
+            .unwrap_or_else(|| panic!("no {field}"))
+        + key.len();
+    let end = start
+        + text[start..]
+            .find(|c: char| c == ',' || c == ')' || c.is_whitespace())
+            .unwrap();
+    format!("{}{value}{}", &text[..start], &text[end..])
+}
+
+#[test]
+fn a_snapshot_with_an_invalid_material_guard_or_solver_setting_is_a_typed_error() {
+    let good = saved();
+    let restored = Snapshot::from_ron(&good).expect("the good one reads");
+    let mut copy = World::new();
+    copy.add_physics(PhysicsPlugins);
+    restored.restore(&mut copy).expect("and restores");
+    for (field, value) in [
+        ("young", "NaN"),
+        ("young", "-1.0"),
+        ("poisson", "NaN"),
+        ("poisson", "-1.0"),
+        ("poisson", "0.5"),
+        ("density", "0.0"),
+        ("max_speed", "NaN"),
+        ("max_spring_strain", "NaN"),
+        ("max_distance", "-1.0"),
+        ("tolerance", "NaN"),
+        ("max_newton", "0"),
+        ("max_cg", "4000000000"),
+    ] {
+        let bad = with(&good, field, value);
+        match Snapshot::from_ron(&bad) {
+            Ok(_) => panic!("{field}: {value} was accepted"),
+            Err(e) => println!("{field}: {value} → {e}"),
+        }
+    }
+}
