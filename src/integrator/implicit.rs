@@ -201,7 +201,9 @@ fn prepare_factor<E: ImplicitElements>(
     h: f32,
 ) {
     let key = (len, body.count());
-    if state.built_for != Some(key) {
+    // A factor for another node count (read from a file that says otherwise) is rebuilt too.
+    let misfit = state.factor.as_ref().is_some_and(|f| f.nodes() != len);
+    if state.built_for != Some(key) || misfit {
         state.built_for = Some(key);
         state.factor = None;
         if settings.max_factor_entries > 0 {

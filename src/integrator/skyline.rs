@@ -86,7 +86,10 @@ pub(crate) fn reverse_cuthill_mckee(adjacency: &[Vec<u32>]) -> Vec<u32> {
 }
 
 /// L of A = L Lᵀ over 3 × 3 node blocks, in the RCM order, stored by rows of its envelope.
+/// Read from a file (a snapshot) its structure is checked (see [`FactorRecord`]): a factor
+/// one number short would index out of bounds in the next solve.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Default)]
+#[serde(try_from = "FactorRecord")]
 pub(crate) struct SkylineCholesky {
     /// `order[k]`: the node whose three unknowns are rows 3k..3k+3.
     order: Vec<u32>,
@@ -109,7 +112,77 @@ pub(crate) struct SkylineCholesky {
     pub(crate) step: f32,
 }
 
+/// [`SkylineCholesky`] as a file holds it.
+#[derive(serde::Deserialize)]
+pub(crate) struct FactorRecord {
+    order: Vec<u32>,
+    rank: Vec<u32>,
+    first: Vec<u32>,
+    start: Vec<usize>,
+    values: Vec<f64>,
+    factored: bool,
+    generation: u64,
+    factor_cost: f64,
+    solve_cost: f64,
+    #[serde(default)]
+    step: f32,
+}
+
+impl TryFrom<FactorRecord> for SkylineCholesky {
+    type Error = String;
+
+    /// The order a permutation with `rank` its inverse, three rows per node, each row's first
+    /// column at or before it, and the rows packed end to end in `values`.
+    fn try_from(r: FactorRecord) -> Result<Self, String> {
+        let n = r.order.len();
+        let bad = |what: &str| Err(format!("implicit factor: {what}"));
+        if r.rank.len() != n {
+            return bad("rank and order differ in length");
+        }
+        for (k, &node) in r.order.iter().enumerate() {
+            if node as usize >= n || r.rank[node as usize] as usize != k {
+                return bad("order is not a permutation with rank its inverse");
+            }
+        }
+        let rows = 3 * n;
+        if r.first.len() != rows || r.start.len() != rows + 1 {
+            return bad("not three rows per node");
+        }
+        let mut next = 0usize;
+        for row in 0..rows {
+            let first = r.first[row] as usize;
+            if first > row || r.start[row] != next {
+                return bad("rows not packed end to end");
+            }
+            next += row - first + 1;
+        }
+        if r.start[rows] != next || r.values.len() != next {
+            return bad("values do not fill the envelope");
+        }
+        if !(r.factor_cost.is_finite() && r.solve_cost.is_finite() && r.step.is_finite()) {
+            return bad("non-finite costs or step");
+        }
+        Ok(Self {
+            order: r.order,
+            rank: r.rank,
+            first: r.first,
+            start: r.start,
+            values: r.values,
+            factored: r.factored,
+            generation: r.generation,
+            factor_cost: r.factor_cost,
+            solve_cost: r.solve_cost,
+            step: r.step,
+        })
+    }
+}
+
 impl SkylineCholesky {
+    /// How many nodes it orders.
+    pub(crate) fn nodes(&self) -> usize {
+        self.order.len()
+    }
+
     /// The envelope of the matrix whose non-zero 3 × 3 blocks are the node pairs of
     /// `adjacency` (symmetric, each list sorted); None when it would hold more than
     /// `max_entries` numbers.

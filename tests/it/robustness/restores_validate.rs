@@ -67,3 +67,33 @@ fn a_snapshot_with_an_invalid_material_guard_or_solver_setting_is_a_typed_error(
         }
     }
 }
+
+#[test]
+fn a_snapshot_whose_implicit_factor_is_one_number_short_is_refused() {
+    // The jelly's kept factor: drop the last number of its `values` (the solve indexed past
+    // it), or name a node past the mesh in its order.
+    let good = saved();
+    let at = good.find("values: [").expect("a kept factor") + "values: [".len();
+    let close = at + good[at..].find(']').unwrap();
+    let numbers = &good[at..close];
+    let last_comma = numbers.trim_end().trim_end_matches(',').rfind(',').unwrap();
+    let short = format!(
+        "{}{}{}",
+        &good[..at],
+        &numbers[..last_comma],
+        &good[close..]
+    );
+    let refused = |text: &str| match Snapshot::from_ron(text) {
+        Ok(_) => panic!("accepted"),
+        Err(e) => e.to_string(),
+    };
+    let e = refused(&short);
+    println!("{e}");
+    assert!(e.contains("implicit factor"), "{e}");
+    let at = good.find("order: [").unwrap() + "order: [".len();
+    let end = at + good[at..].find(',').unwrap();
+    let renamed = format!("{}4294967295{}", &good[..at], &good[end..]);
+    let e = refused(&renamed);
+    println!("{e}");
+    assert!(e.contains("implicit factor"), "{e}");
+}
