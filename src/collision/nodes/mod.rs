@@ -174,7 +174,19 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
             }
             let pose = crate::collision::shape_pose(x.0, q.0, com);
             let mut rigid = side_of(x, q, d);
-            let hits = find_hits(n, c, &pose, q.0, aabb, thickness);
+            // Guarded as pair geometry is (parry asserts on some degenerate inputs): a mesh
+            // whose contact with this collider fails leaves, named with it.
+            let found = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                find_hits(n, c, &pose, q.0, aabb, thickness)
+            }));
+            let Ok(hits) = found else {
+                commands.entity(mesh).try_insert(Quarantined {
+                    reason: crate::core::quarantine::QuarantineReason::GeometryFailed {
+                        other: entity,
+                    },
+                });
+                break;
+            };
             if hits.is_empty() {
                 continue;
             }
@@ -249,6 +261,11 @@ fn find_hits(
             continue;
         }
         let local = inverse * p;
+        if !local.is_finite() {
+            // A node gone non-finite is caught by its own check; projecting it would trip
+            // parry's asserts (NaN against a capsule of half height 0).
+            continue;
+        }
         let solid = shape.project_local_point(local, true);
         let (normal_local, depth) = if solid.is_inside {
             // Inside: the solid projection is the point itself; the surface is the way out.

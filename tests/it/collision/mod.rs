@@ -11,6 +11,7 @@ mod fast_spin_stays_above_ground;
 mod landing_stays_in_place;
 mod mesh_contacts;
 mod no_tunnelling;
+mod node_contacts_never_panic;
 mod recycling;
 mod restitution_energy;
 mod restitution_threshold;
