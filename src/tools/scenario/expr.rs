@@ -81,6 +81,8 @@ impl Expr {
         let mut p = Parser {
             s: text.as_bytes(),
             i: 0,
+            depth: 0,
+            operators: 0,
         };
         let e = p.expr()?;
         p.skip_ws();
@@ -124,9 +126,19 @@ impl Expr {
     }
 }
 
+/// How deep an expression may nest (parentheses, signs, powers, calls): a parser that
+/// recursed 100,000 parentheses deep overflowed the stack and aborted the process.
+pub const MAX_DEPTH: u32 = 256;
+
+/// How many operators an expression may hold: evaluating and dropping a chain of 100,000
+/// additions recurses as deep as the chain is long.
+pub const MAX_OPERATORS: u32 = 4096;
+
 struct Parser<'a> {
     s: &'a [u8],
     i: usize,
+    depth: u32,
+    operators: u32,
 }
 
 impl Parser<'_> {
@@ -148,9 +160,22 @@ impl Parser<'_> {
         }
     }
 
+    /// Counts one more operator, refusing past [`MAX_OPERATORS`].
+    fn operator(&mut self) -> Result<(), String> {
+        self.operators += 1;
+        if self.operators > MAX_OPERATORS {
+            return Err(format!(
+                "more than {MAX_OPERATORS} operators (column {})",
+                self.i + 1
+            ));
+        }
+        Ok(())
+    }
+
     fn expr(&mut self) -> Result<Expr, String> {
         let mut e = self.term()?;
         while let Some(c @ (b'+' | b'-')) = self.peek() {
+            self.operator()?;
             self.i += 1;
             let op = if c == b'+' { Op::Add } else { Op::Sub };
             e = Expr::Bin(op, Box::new(e), Box::new(self.term()?));
@@ -161,6 +186,7 @@ impl Parser<'_> {
     fn term(&mut self) -> Result<Expr, String> {
         let mut e = self.unary()?;
         while let Some(c @ (b'*' | b'/')) = self.peek() {
+            self.operator()?;
             self.i += 1;
             let op = if c == b'*' { Op::Mul } else { Op::Div };
             e = Expr::Bin(op, Box::new(e), Box::new(self.unary()?));
@@ -168,13 +194,29 @@ impl Parser<'_> {
         Ok(e)
     }
 
+    /// Every recursion of the parser passes here: the nesting is counted and bounded.
     fn unary(&mut self) -> Result<Expr, String> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            return Err(format!(
+                "nested deeper than {MAX_DEPTH} at column {}",
+                self.i + 1
+            ));
+        }
+        let e = self.signed();
+        self.depth -= 1;
+        e
+    }
+
+    fn signed(&mut self) -> Result<Expr, String> {
         if self.peek() == Some(b'-') {
+            self.operator()?;
             self.i += 1;
             return Ok(Expr::Neg(Box::new(self.unary()?)));
         }
         let base = self.atom()?;
         if self.peek() == Some(b'^') {
+            self.operator()?;
             self.i += 1;
             // −t^2 is −(t²) and 2^-1 is ½: the exponent is a unary.
             return Ok(Expr::Bin(Op::Pow, Box::new(base), Box::new(self.unary()?)));

@@ -711,8 +711,16 @@ fn check_expectation(
             tolerance(*tol, "tolerance")?;
             return Expr::parse(value)
                 .map(Some)
-                .map_err(|m| bad(format!("closed form \"{value}\": {m}")));
+                .map_err(|m| bad(format!("closed form \"{}\": {m}", excerpt(value))));
         }
     }
     Ok(None)
+}
+
+/// `text` as an error message quotes it: its first 60 characters, and how long it was.
+fn excerpt(text: &str) -> String {
+    match text.char_indices().nth(60) {
+        Some((end, _)) => format!("{}… ({} characters)", &text[..end], text.chars().count()),
+        None => text.to_string(),
+    }
 }

@@ -4,3 +4,4 @@ mod checks;
 mod cli;
 mod corpus;
 mod errors;
+mod hostile_expressions;
