@@ -82,12 +82,16 @@ impl TetMesh {
         Ok(Self { points, tets })
     }
 
+    /// The most cells [`TetMesh::cuboid`] cuts a box into: 2²⁰ (up to 6.3 million
+    /// tetrahedra).
+    pub const MAX_CELLS: usize = 1 << 20;
+
     /// A box of `size` (full lengths, m) centred at the origin, cut into `cells` hexahedra
     /// along x, y, z and each of those into tetrahedra by `split`.
     ///
     /// # Errors
     /// [`Error::NotPositive`] for a bad size, [`Error::TooFew`] for a zero cell count or one
-    /// too large to index.
+    /// over 1024 a side, [`Error::TooMany`] past [`TetMesh::MAX_CELLS`] in all.
     pub fn cuboid(size: Vec3, cells: [usize; 3], split: CellSplit) -> Result<Self> {
         for s in size.to_array() {
             positive("box size", s)?;
@@ -99,6 +103,15 @@ impl TetMesh {
                 what: "cells per side (1 to 1024)",
                 min: 1,
                 got: *cells.iter().find(|&&c| too_big(c)).unwrap_or(&0),
+            });
+        }
+        // 1024 a side would be 10⁹ cells and 6·10⁹ tetrahedra: an allocation abort, not an
+        // error. The whole box is bounded too.
+        if nx * ny * nz > Self::MAX_CELLS {
+            return Err(Error::TooMany {
+                what: "cells in a cuboid mesh",
+                max: Self::MAX_CELLS as u64,
+                got: (nx * ny * nz) as u64,
             });
         }
         let id = |i: usize, j: usize, k: usize| ((k * (ny + 1) + j) * (nx + 1) + i) as u32;

@@ -390,7 +390,25 @@ pub fn box_stack(world: &mut World, n: usize) -> Result<Vec<Entity>> {
 /// # Errors
 /// As [`spawn_boxes`].
 pub fn pyramid(world: &mut World, layers: usize) -> Result<Vec<Entity>> {
+    check_boxes(layers.checked_mul(layers.saturating_add(1)).map(|n| n / 2))?;
     spawn_boxes(world, &pyramid_spec(layers))
+}
+
+/// The most boxes [`box_column`] and [`pyramid`] spawn: 2²⁰. A scenario asking for 10⁹ (or a
+/// pyramid of 2³² rows, whose count overflows) aborted on allocation.
+pub const MAX_SCENE_BOXES: usize = 1 << 20;
+
+/// Refuses a box count past [`MAX_SCENE_BOXES`] (None: it overflowed) before anything is
+/// allocated.
+fn check_boxes(count: Option<usize>) -> Result<()> {
+    match count {
+        Some(n) if n <= MAX_SCENE_BOXES => Ok(()),
+        _ => Err(crate::core::error::Error::TooMany {
+            what: "boxes in a scene",
+            max: MAX_SCENE_BOXES as u64,
+            got: count.map_or(u64::MAX, |n| n as u64),
+        }),
+    }
 }
 
 /// [`falling_boxes_spec`], spawned.
@@ -475,6 +493,7 @@ pub fn perturbed_column_spec(n: usize, offset: f32, run: usize) -> Vec<BoxSpec> 
 /// # Errors
 /// As [`spawn_boxes`].
 pub fn box_column(world: &mut World, n: usize) -> Result<Vec<Entity>> {
+    check_boxes(Some(n))?;
     spawn_boxes(world, &column_spec(n))
 }
 

@@ -8,3 +8,4 @@ mod fuzz_findings;
 mod harness;
 mod restores_validate;
 mod runaway_velocity_quarantined_first;
+mod sizes_are_bounded;
