@@ -250,13 +250,6 @@ pub(crate) fn step_locally(
     true
 }
 
-/// Local substeps per substep of `substep` (s) that keep a system of limit `h_crit` stable,
-/// with a 10% margin (at least 1).
-#[must_use]
-pub fn local_substeps_needed(substep: f32, h_crit: f32) -> u32 {
-    substeps_needed(substep, h_crit)
-}
-
 /// Written once per system whose explicit stability limit is below the substep.
 #[derive(Message, Debug, Clone, PartialEq)]
 pub struct StabilityWarning {
@@ -294,6 +287,66 @@ impl StabilityWarning {
                 self.entity, self.substep, self.critical_step, self.substeps_needed
             ),
         }
+    }
+}
+
+/// One system's explicit limit as its effect computed it this step, for [`apply_policy`].
+pub(crate) struct SystemLimit {
+    /// The mesh, soft body or spring the rescue goes on.
+    pub entity: Entity,
+    /// Its limit h_crit (s).
+    pub critical_step: f32,
+    /// The integrator it runs under.
+    pub method: Integrator,
+    /// Its effect's measured crossover of local substeps against its implicit solve.
+    pub cheaper_up_to: u32,
+    /// Whether the limit was recomputed this step (its elements or masses changed).
+    pub fresh: bool,
+    /// The local substeps it is rescued by, if any.
+    pub local: Option<LocalSubsteps>,
+}
+
+/// The policy on one system: past its limit for the first time, it is rescued and told once
+/// (`warned` is set); rescued by local substeps whose count its changed elements or masses
+/// outgrew, it is re-decided silently. Spring meshes and soft bodies share it.
+#[allow(clippy::too_many_arguments)] // the system's context, passed through
+pub(crate) fn apply_policy(
+    commands: &mut Commands,
+    warnings: &mut MessageWriter<StabilityWarning>,
+    diag: Option<&mut crate::core::diagnostics::PhysicsDiagnostics>,
+    policy: StabilityPolicy,
+    (dt, substep): (f32, f32),
+    system: &SystemLimit,
+    warned: &mut bool,
+) {
+    let options = RescueOptions {
+        local_substeps: Some(substeps_needed(substep, system.critical_step)),
+        cheaper_up_to: system.cheaper_up_to,
+        no_bdf2: false,
+    };
+    match system.local {
+        Some(l) if system.fresh && substep / l.count() as f32 > system.critical_step => {
+            if let Some(rescue) = policy.choose(system.method, options) {
+                put_rescue(commands, system.entity, rescue);
+            }
+        }
+        Some(_) => {}
+        None if !*warned && substep > system.critical_step => {
+            *warned = true;
+            let rescue = policy.choose(system.method, options);
+            if let Some(rescue) = rescue {
+                put_rescue(commands, system.entity, rescue);
+            }
+            tell(
+                warnings,
+                diag,
+                system.entity,
+                system.critical_step,
+                (dt, substep),
+                rescue,
+            );
+        }
+        None => {}
     }
 }
 

@@ -26,10 +26,10 @@ use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::quarantine::Quarantined;
 use crate::core::time::PhysicsTime;
 use crate::integrator::stability::{
-    LocalSubsteps, RescueOptions, StabilityPolicy, StabilityWarning, critical_step,
-    local_substeps_needed, put_rescue, tell,
+    LocalSubsteps, StabilityPolicy, StabilityWarning, SystemLimit, apply_policy, critical_step,
+    put_rescue,
 };
-use crate::integrator::{ImplicitEuler, Integrator, IntegratorOverride};
+use crate::integrator::{ImplicitEuler, ImplicitScheme, Integrator, IntegratorOverride, Rescue};
 
 /// Local substeps per substep at most that [`StabilityPolicy::Automatic`] takes for a soft
 /// body before it solves it by BDF2 instead: the count at which they cost about what BDF2's
@@ -102,46 +102,33 @@ pub(crate) fn check_soft_stability(
         if implicit || method == Integrator::ImplicitEuler {
             continue;
         }
-        let options = RescueOptions {
-            local_substeps: Some(local_substeps_needed(substep, stability.critical_step)),
-            cheaper_up_to: LOCAL_SUBSTEPS_CHEAPER_UP_TO,
-            no_bdf2: false,
-        };
-        match local {
-            // Rescued by local substeps: re-decided (silently) if its material changed past
-            // what its count holds, and solved by BDF2 once it presses on a dynamic body
-            // (which takes its impulses once per substep, not per local step: the body would
-            // sink into it by millimetres).
-            Some(_) if body.touched_a_body => {
-                let bdf2 =
-                    crate::integrator::Rescue::Implicit(crate::integrator::ImplicitScheme::Bdf2);
-                if policy.choose(method, options).is_some() {
-                    put_rescue(&mut commands, e, bdf2);
-                }
+        // Rescued by local substeps, it is solved by BDF2 once it presses on a dynamic body
+        // (which takes its impulses once per substep, not per local step: the body would
+        // sink into it by millimetres).
+        if local.is_some() && body.touched_a_body {
+            if policy.rescue(method).is_some() {
+                put_rescue(&mut commands, e, Rescue::Implicit(ImplicitScheme::Bdf2));
             }
-            Some(l) if fresh && substep / l.count() as f32 > stability.critical_step => {
-                if let Some(rescue) = policy.choose(method, options) {
-                    put_rescue(&mut commands, e, rescue);
-                }
-            }
-            Some(_) => {}
-            None if !stability.warned && substep > stability.critical_step => {
-                stability.warned = true;
-                let rescue = policy.choose(method, options);
-                if let Some(rescue) = rescue {
-                    put_rescue(&mut commands, e, rescue);
-                }
-                tell(
-                    &mut warnings,
-                    diag.as_deref_mut(),
-                    e,
-                    stability.critical_step,
-                    (time.dt(), substep),
-                    rescue,
-                );
-            }
-            None => {}
+            continue;
         }
+        let system = SystemLimit {
+            entity: e,
+            critical_step: stability.critical_step,
+            method,
+            cheaper_up_to: LOCAL_SUBSTEPS_CHEAPER_UP_TO,
+            fresh,
+            local: local.copied(),
+        };
+        let SoftStability { warned, .. } = &mut *stability;
+        apply_policy(
+            &mut commands,
+            &mut warnings,
+            diag.as_deref_mut(),
+            policy,
+            (time.dt(), substep),
+            &system,
+            warned,
+        );
     }
     if let Some(d) = diag.as_mut() {
         d.soft_critical_step = smallest;

@@ -201,14 +201,11 @@ impl LocalSolve {
             for (i, b) in self.bodies.iter_mut().enumerate() {
                 b.v += (hs * b.w) * self.f[i];
                 b.x += hs * b.v;
-                if let Some(t) = b.turning.as_mut()
-                    && !t.inertia.is_infinite()
-                {
-                    t.l += hs * self.tau[i];
-                    let stored = crate::rigid::omega_of(&t.inertia, t.q, t.l, t.stored);
-                    t.q = crate::rigid::turn(t.q, t.l, stored, &t.inertia, hs, update, false)
-                        .normalize();
-                } else if let Some(t) = b.turning.as_mut() {
+                if let Some(t) = b.turning.as_mut() {
+                    // `turn` takes ω from L (the stored ω only for infinite inertia).
+                    if !t.inertia.is_infinite() {
+                        t.l += hs * self.tau[i];
+                    }
                     t.q = crate::rigid::turn(t.q, t.l, t.stored, &t.inertia, hs, update, false)
                         .normalize();
                 }
@@ -318,8 +315,7 @@ pub(crate) fn substep_entity_springs(
             }
             // The body's own turn from q₀ with the local L, as the orientation phase will
             // take it; the correction rotates that onto the local q.
-            let stored = crate::rigid::omega_of(&t.inertia, t.q0, t.l, t.stored);
-            let own = crate::rigid::turn(t.q0, t.l, stored, &t.inertia, h, update, false);
+            let own = crate::rigid::turn(t.q0, t.l, t.stored, &t.inertia, h, update, false);
             turn = t.q * own.normalize().inverse();
         }
         corrections.0.push((b.entity, b.x - (b.x0 + h * b.v), turn));

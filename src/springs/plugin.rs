@@ -199,13 +199,19 @@ fn apply_spring_forces(
             // check after integration; its neighbours must not catch its NaN meanwhile.
             continue;
         }
-        let strain = if s.rest_length > 0.0 && s.stiffness > 0.0 {
-            ((pb - pa).length() - s.rest_length) / s.rest_length
-        } else {
-            0.0
+        // Compared squared: no square root per spring in the hot loop.
+        let torn = s.rest_length > 0.0 && s.stiffness > 0.0 && {
+            let (r, d2) = (s.rest_length, (pb - pa).length_squared());
+            let longest = r * (1.0 + guard.max_spring_strain);
+            let shortest = (r * (1.0 - guard.max_spring_strain)).max(0.0);
+            d2 > longest * longest || d2 < shortest * shortest
         };
-        if !f.is_finite() || strain.abs() > guard.max_spring_strain {
-            let strain = if f.is_finite() { strain } else { f32::NAN };
+        if !f.is_finite() || torn {
+            let strain = if f.is_finite() {
+                ((pb - pa).length() - s.rest_length) / s.rest_length
+            } else {
+                f32::NAN
+            };
             // A pinned end (a hook in the ceiling) did not diverge and stays.
             for end in [s.a, s.b]
                 .into_iter()

@@ -31,8 +31,8 @@ use super::{Spring, SpringNetwork};
 use crate::core::diagnostics::PhysicsDiagnostics;
 use crate::core::time::PhysicsTime;
 use crate::integrator::stability::{
-    LocalSubsteps, Rescue, RescueOptions, StabilityPolicy, StabilityWarning, critical_step,
-    local_substeps_needed, put_rescue, tell,
+    LocalSubsteps, RescueOptions, StabilityPolicy, StabilityWarning, SystemLimit, apply_policy,
+    critical_step, put_rescue, substeps_needed, tell,
 };
 use crate::integrator::{ImplicitEuler, Integrator, IntegratorOverride};
 use crate::particles::{Mass, Nodes};
@@ -141,19 +141,6 @@ pub(crate) fn check_stability(
     let policy = policy.map_or_else(StabilityPolicy::default, |p| *p);
     let substep = time.dt() / time.substeps() as f32;
     let mut smallest = f32::INFINITY;
-    let mut warn = |entity: Entity,
-                    h_crit: f32,
-                    rescue: Option<Rescue>,
-                    diag: &mut Option<ResMut<PhysicsDiagnostics>>| {
-        tell(
-            &mut warnings,
-            diag.as_deref_mut(),
-            entity,
-            h_crit,
-            (time.dt(), substep),
-            rescue,
-        );
-    };
     let implicit_dial = global == Integrator::ImplicitEuler;
     for (e, nodes, network, mut stability, implicit, o, local) in &mut meshes {
         let fresh = !stability.computed || nodes.is_changed() || network.is_changed();
@@ -165,30 +152,24 @@ pub(crate) fn check_stability(
         if implicit || implicit_dial {
             continue;
         }
-        let options = RescueOptions {
-            local_substeps: Some(local_substeps_needed(substep, stability.critical_step)),
+        let system = SystemLimit {
+            entity: e,
+            critical_step: stability.critical_step,
+            method: o.map_or(global, |o| o.0),
             cheaper_up_to: LOCAL_SUBSTEPS_CHEAPER_UP_TO,
-            no_bdf2: false,
+            fresh,
+            local: local.copied(),
         };
-        match local {
-            // Rescued by local substeps: re-decided (silently) if its springs or masses
-            // changed past what its count holds.
-            Some(l) if fresh && substep / l.count() as f32 > stability.critical_step => {
-                if let Some(rescue) = policy.choose(o.map_or(global, |o| o.0), options) {
-                    put_rescue(&mut commands, e, rescue);
-                }
-            }
-            Some(_) => {}
-            None if !stability.warned && substep > stability.critical_step => {
-                stability.warned = true;
-                let rescue = policy.choose(o.map_or(global, |o| o.0), options);
-                if let Some(rescue) = rescue {
-                    put_rescue(&mut commands, e, rescue);
-                }
-                warn(e, stability.critical_step, rescue, &mut diag);
-            }
-            None => {}
-        }
+        let SpringStability { warned, .. } = &mut *stability;
+        apply_policy(
+            &mut commands,
+            &mut warnings,
+            diag.as_deref_mut(),
+            policy,
+            (time.dt(), substep),
+            &system,
+            warned,
+        );
     }
     // The entity springs integrated explicitly; the implicit ones have no limit.
     let explicit = |flagged: bool| !super::entity_implicit::wants_implicit(global, flagged);
@@ -240,7 +221,7 @@ pub(crate) fn check_stability(
         let rescue = policy.choose(
             Integrator::SymplecticEuler,
             RescueOptions {
-                local_substeps: Some(local_substeps_needed(substep, best_limit(&rows))),
+                local_substeps: Some(substeps_needed(substep, best_limit(&rows))),
                 cheaper_up_to: LOCAL_SUBSTEPS_CHEAPER_UP_TO,
                 no_bdf2: levered,
             },
@@ -274,11 +255,13 @@ pub(crate) fn check_stability(
             && substep > best.0
         {
             entity_limit.warned = true;
-            warn(
+            tell(
+                &mut warnings,
+                diag.as_deref_mut(),
                 spring,
                 best.0,
+                (time.dt(), substep),
                 rescue.filter(|_| stiff.contains(&spring)),
-                &mut diag,
             );
         }
         if let Some(rescue) = rescue {

@@ -223,13 +223,29 @@ fn a_top_on_a_stiff_pivot_keeps_its_spin_at_the_defaults() {
     // its spin about its own axis is conserved exactly (no torque about a symmetry axis
     // through the pivot). The pivot's mode is about √(k (1/m + l²/I₁)) = 2300 rad/s at 1e6
     // N/m, h_crit ≈ 0.85 ms: past the default substep. The reference is the same top
-    // integrated explicitly at 64 substeps (h = 0.26 ms).
+    // integrated explicitly at h ≈ 0.26 ms (64 substeps at 60 Hz). At the defaults first,
+    // then at other frame rates and substep counts.
+    top_keeps_its_spin(None);
+    for (hz, substeps) in [(30.0f32, 4u32), (60.0, 8), (144.0, 4)] {
+        top_keeps_its_spin(Some((hz, substeps)));
+    }
+}
+
+/// The top of the test above for 10 s at `time` (None: the defaults), against explicit
+/// integration at about 3840 substeps a second.
+fn top_keeps_its_spin(time: Option<(f32, u32)>) {
+    use hooke::core::time::PhysicsTime;
     let (k, spin) = (1e6f32, 200.0f32);
+    let (hz, substeps) = time.unwrap_or((60.0, 4));
     let mut w = common::default_world();
+    if time.is_some() {
+        w.insert_resource(PhysicsTime::new(1.0 / hz, substeps).unwrap());
+    }
     let top = scenes::top_on_a_pivot(&mut w, k, spin).unwrap();
     let mut reference = common::default_world();
     reference.insert_resource(hooke::integrator::StabilityPolicy::Warn);
-    reference.insert_resource(hooke::core::time::PhysicsTime::new(1.0 / 60.0, 64).unwrap());
+    let fine = (3840.0 / hz).ceil() as u32;
+    reference.insert_resource(PhysicsTime::new(1.0 / hz, fine).unwrap());
     let top_ref = scenes::top_on_a_pivot(&mut reference, k, spin).unwrap();
     w.step_physics();
     reference.step_physics();
@@ -240,7 +256,7 @@ fn a_top_on_a_stiff_pivot_keeps_its_spin_at_the_defaults() {
     };
     let (spin0, _) = spin_and_tilt(&w, top);
     let mut tilt_gap = 0.0f32;
-    for _ in 0..600 {
+    for _ in 0..(10.0 * hz) as usize {
         w.step_physics();
         reference.step_physics();
         tilt_gap =
@@ -249,7 +265,7 @@ fn a_top_on_a_stiff_pivot_keeps_its_spin_at_the_defaults() {
     let (spin1, tilt) = spin_and_tilt(&w, top);
     let (_, tilt_ref) = spin_and_tilt(&reference, top_ref);
     println!(
-        "top on a {k:e} N/m pivot, 10 s at the defaults ({n} local substeps): spin {spin0:.3} → {spin1:.3} rad/s ({:+.4}%), tilt {tilt:.3} rad (explicit ×64: {tilt_ref:.3}; largest gap {tilt_gap:.3} rad)",
+        "top on a {k:e} N/m pivot, 10 s at {hz} Hz x{substeps} ({n} local substeps): spin {spin0:.3} → {spin1:.3} rad/s ({:+.4}%), tilt {tilt:.3} rad (explicit ×{fine}: {tilt_ref:.3}; largest gap {tilt_gap:.3} rad)",
         100.0 * (spin1 / spin0 - 1.0)
     );
     assert_eq!(w.resource::<PhysicsDiagnostics>().quarantined_total, 0);
