@@ -155,23 +155,62 @@ fn attachment_changed(mut world: DeferredWorld, ctx: HookContext) {
 #[derive(serde::Serialize, serde::Deserialize, Component, Clone)]
 pub(crate) struct OwnShape(Collider);
 
+/// The most levels a collider part may sit below its body (a child is one level). A part
+/// deeper than this is quarantined with [`Error::TooMany`] rather than left out silently:
+/// the walk up from a part must stop somewhere, since game code can link `ChildOf` in a
+/// cycle.
+pub const MAX_PART_DEPTH: usize = 256;
+
+/// What is above a collider on an entity.
+enum Owner {
+    /// The nearest body at or above it.
+    Body(Entity),
+    /// No body up to the root.
+    None,
+    /// More than [`MAX_PART_DEPTH`] levels and still no body (or a cycle).
+    TooDeep,
+}
+
 /// The body a collider on `entity` belongs to: `entity` itself if it is a body, else the
 /// nearest ancestor that is.
-fn owner(world: &World, entity: Entity) -> Option<Entity> {
+fn find_owner(world: &World, entity: Entity) -> Owner {
     let mut e = entity;
-    // Hierarchies are acyclic; the cap only bounds a pathological depth.
-    for _ in 0..256 {
+    for _ in 0..=MAX_PART_DEPTH {
         if world.get::<RigidBody>(e).is_some() {
-            return Some(e);
+            return Owner::Body(e);
         }
-        e = world.get::<ChildOf>(e)?.parent();
+        match world.get::<ChildOf>(e) {
+            Some(parent) => e = parent.parent(),
+            None => return Owner::None,
+        }
     }
-    None
+    Owner::TooDeep
+}
+
+fn owner(world: &World, entity: Entity) -> Option<Entity> {
+    match find_owner(world, entity) {
+        Owner::Body(e) => Some(e),
+        Owner::None | Owner::TooDeep => None,
+    }
+}
+
+fn too_deep() -> Quarantined {
+    Quarantined {
+        reason: QuarantineReason::InvalidInput(Error::TooMany {
+            what: "levels between a collider part and its body",
+            max: MAX_PART_DEPTH as u64,
+            got: MAX_PART_DEPTH as u64 + 1,
+        }),
+    }
 }
 
 /// Queues [`refresh_body`] for the body that owns a collider on `entity`, if any.
 pub(crate) fn queue_refresh_owner(world: &mut DeferredWorld, entity: Entity) {
-    if let Some(body) = owner(world, entity) {
+    let found = find_owner(world, entity);
+    if matches!(found, Owner::TooDeep) && world.get::<Collider>(entity).is_some() {
+        world.commands().entity(entity).try_insert(too_deep());
+    }
+    if let Owner::Body(body) = found {
         world
             .commands()
             .queue(move |world: &mut World| refresh_body(world, body));
@@ -295,7 +334,13 @@ fn is_composite(shape: &SharedShape) -> bool {
 
 /// Gathers the collider parts of `body`'s subtree (stopping at nested bodies), depth first
 /// in `Children` order so that the compound is the same from run to run.
-fn collect_parts(world: &World, body: Entity, own: Option<&Collider>) -> Vec<Part> {
+/// Colliders deeper than [`MAX_PART_DEPTH`] go to `too_deep` instead.
+fn collect_parts(
+    world: &World,
+    body: Entity,
+    own: Option<&Collider>,
+    too_deep: &mut Vec<Entity>,
+) -> Vec<Part> {
     let density = |e: Entity| {
         world
             .get::<ColliderDensity>(e)
@@ -310,17 +355,25 @@ fn collect_parts(world: &World, body: Entity, own: Option<&Collider>) -> Vec<Par
             density: density(body),
         });
     }
-    let mut stack: Vec<(Entity, Pose)> = Vec::new();
-    let push_children = |stack: &mut Vec<(Entity, Pose)>, e: Entity, pose: Pose| {
+    let mut stack: Vec<(Entity, Pose, usize)> = Vec::new();
+    let push_children = |stack: &mut Vec<(Entity, Pose, usize)>, e: Entity, pose, depth| {
         if let Some(children) = world.get::<Children>(e) {
             for c in children.iter().rev() {
-                stack.push((c, pose));
+                stack.push((c, pose, depth + 1));
             }
         }
     };
-    push_children(&mut stack, body, Pose::IDENTITY);
-    while let Some((e, parent_pose)) = stack.pop() {
+    push_children(&mut stack, body, Pose::IDENTITY, 0);
+    while let Some((e, parent_pose, depth)) = stack.pop() {
         if world.get::<RigidBody>(e).is_some() || world.get::<Quarantined>(e).is_some() {
+            continue;
+        }
+        if depth > MAX_PART_DEPTH {
+            // Left for the caller to quarantine, with everything below it.
+            if world.get::<Collider>(e).is_some() {
+                too_deep.push(e);
+            }
+            push_children(&mut stack, e, parent_pose, depth);
             continue;
         }
         let offset = world
@@ -335,7 +388,7 @@ fn collect_parts(world: &World, body: Entity, own: Option<&Collider>) -> Vec<Par
                 density: density(e),
             });
         }
-        push_children(&mut stack, e, pose);
+        push_children(&mut stack, e, pose, depth);
     }
     parts
 }
@@ -351,7 +404,11 @@ pub(crate) fn refresh_body(world: &mut World, body: Entity) {
         (_, Some(c)) if !c.composed => Some(c.clone()),
         _ => None,
     };
-    let mut parts = collect_parts(world, body, own.as_ref());
+    let mut deep = Vec::new();
+    let mut parts = collect_parts(world, body, own.as_ref(), &mut deep);
+    for e in deep {
+        world.entity_mut(e).insert(too_deep());
+    }
 
     // Parts parry cannot nest are left out; their entities are quarantined.
     let has_children = parts.iter().any(|p| p.entity != body);
@@ -463,9 +520,13 @@ fn mass_from_parry(p: &ParryMass) -> Result<crate::rigid::MassProperties> {
     crate::rigid::MassProperties::new(mass, p.local_com, inertia)
 }
 
+type SoundBody<'a> = (&'a Position, &'a Rotation, Option<&'a CenterOfMass>);
+
 /// After a step: every attached collider's [`Position`] and [`Rotation`] at its world pose.
+/// The parts of a quarantined body stay where the body last was sound (its state may be
+/// the non-finite one that quarantined it).
 pub(crate) fn place_attached_colliders(
-    bodies: Query<(&Position, &Rotation, Option<&CenterOfMass>), Without<ColliderOf>>,
+    bodies: Query<SoundBody, (Without<ColliderOf>, Without<Quarantined>)>,
     mut parts: Query<(&ColliderOf, &mut Position, &mut Rotation)>,
 ) {
     for (of, mut x, mut q) in &mut parts {

@@ -68,7 +68,7 @@ pub(crate) mod slots;
 pub(crate) mod solver;
 
 pub(crate) use attach::OwnShape;
-pub use attach::{ColliderDensity, ColliderOf, ColliderOffset};
+pub use attach::{ColliderDensity, ColliderOf, ColliderOffset, MAX_PART_DEPTH};
 pub(crate) use narrow_phase::ContactsRecord;
 pub use narrow_phase::{ContactPair, Contacts};
 pub(crate) use nodes::coupling::NodeImpulse;

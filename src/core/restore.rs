@@ -31,6 +31,12 @@ pub struct InvalidSetting {
     pub value: f32,
 }
 
+/// Present while a snapshot writes its entities: insert hooks that check other entities
+/// (a spring's ends) wait, since the entities are written in storage order and an end may
+/// come after the spring; the restore checks them once everything is written.
+#[derive(Resource, Default)]
+pub(crate) struct Restoring;
+
 /// How to re-create each installed resource.
 #[derive(Resource, Default)]
 pub(crate) struct Restorers(Vec<fn(&mut World) -> Option<&'static str>>);

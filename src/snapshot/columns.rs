@@ -324,24 +324,31 @@ macro_rules! columns {
                 )*
             }
 
+            /// Moves every value from slot `s` to `to[s]` (a permutation), keeping each
+            /// column in slot order (for the digest).
+            pub(crate) fn reslot(&mut self, to: &[u32]) {
+                $(
+                    for (slot, _) in &mut self.$field {
+                        *slot = to[*slot as usize];
+                    }
+                    self.$field.sort_by_key(|(slot, _)| *slot);
+                )*
+            }
+
             /// The node count of every slot that has nodes, for the mesh checks across components.
             pub(crate) fn nodes_of(&self) -> HashMap<u32, usize> {
                 self.nodes.iter().map(|(slot, n)| (*slot, n.len())).collect()
             }
 
-            /// Spawns the components of every slot `include` takes on `ids[slot]` as one
-            /// bundle each, in slot order, so that the restored entities sit in the captured
-            /// storage order.
+            /// Spawns the components of every slot on `ids[slot]` as one bundle each, in slot
+            /// order, so that the restored entities sit in the captured storage order (tables
+            /// made in the order their first entity comes).
             #[allow(unsafe_code)]
-            pub(crate) fn write(&self, world: &mut World, ids: &[Entity], include: impl Fn(u32) -> bool) {
+            pub(crate) fn write(&self, world: &mut World, ids: &[Entity]) {
                 let mut scratch = BundleScratch::default();
                 $(let mut $field = self.$field.iter().peekable();)*
                 for (slot, &id) in ids.iter().enumerate() {
                     let slot = slot as u32;
-                    if !include(slot) {
-                        $(while $field.next_if(|(s, _)| *s == slot).is_some() {})*
-                        continue;
-                    }
                     let mut writer = scratch.writer();
                     $(
                         if let Some((_, value)) = $field.next_if(|(s, _)| *s == slot) {
@@ -469,8 +476,7 @@ impl Columns {
         Ok(())
     }
 
-    /// Whether `slot` holds a spring (written after every body, so that its insert hook
-    /// finds both ends).
+    /// The slots that hold a spring (their ends are checked once every entity is written).
     pub(crate) fn spring_slots(&self) -> Vec<u32> {
         self.spring.iter().map(|(slot, _)| *slot).collect()
     }

@@ -395,10 +395,24 @@ impl Snapshot {
             // Allocated just above and never spawned, so this cannot fail.
             let _ = world.spawn_empty_at(id);
         }
-        let springs = columns.spring_slots();
-        let is_spring = |slot: u32| springs.binary_search(&slot).is_ok();
-        columns.write(world, &ids, |slot| !is_spring(slot));
-        columns.write(world, &ids, is_spring);
+        // One pass in slot order, so that the tables are made in the captured order: a
+        // spring's check of its ends waits until every end is written.
+        world.insert_resource(crate::core::restore::Restoring);
+        columns.write(world, &ids);
+        world.remove_resource::<crate::core::restore::Restoring>();
+        for slot in columns.spring_slots() {
+            let id = ids[slot as usize];
+            let Some(spring) = world.get::<crate::springs::Spring>(id).copied() else {
+                continue;
+            };
+            if let Err(error) = crate::springs::ends_exist(world, &spring) {
+                world
+                    .entity_mut(id)
+                    .insert(crate::core::quarantine::Quarantined {
+                        reason: crate::core::quarantine::QuarantineReason::InvalidInput(error),
+                    });
+            }
+        }
         // The insert hooks queued their bookkeeping (mass from colliders, compound parts).
         world.flush();
         columns.settle(world, &ids);
@@ -429,14 +443,20 @@ impl Snapshot {
     }
 
     /// A 64-bit digest of the whole state (FNV-1a over the binary payload): the same inputs
-    /// give the same digest, so a pinned digest shows when a change alters results. Entities
-    /// are counted by their place in storage order, not by id: a plugin that adds a
-    /// resource (and so shifts every entity id after it) leaves digests as they were. The
-    /// entities a [`crate::core::quarantine::QuarantineReason`] names are the exception (kept as ids).
+    /// give the same digest, so a pinned digest shows when a change alters results.
+    ///
+    /// The digest does not depend on entity ids or on how the entities sit in storage:
+    /// entities are counted by their rank in id order, which a restore keeps (new ids are
+    /// handed out in the captured order) and which a plugin that adds a resource (and so
+    /// shifts every id after it) does not change; storage order follows the tables, and game
+    /// components or relations (a `ChildOf`) that a snapshot does not hold can move an
+    /// entity to another table. So a world and its restored copy have the same digest, and
+    /// keep it while they step. The entities a
+    /// [`crate::core::quarantine::QuarantineReason`] names are the exception (kept as ids).
     #[must_use]
     pub fn digest(&self) -> u64 {
         let mut canonical = self.clone();
-        canonical.rename_by_slot();
+        canonical.rename_by_rank();
         let payload = postcard::to_stdvec(&canonical).unwrap_or_default();
         // FNV-1a: four lines, stable across platforms and versions (a hasher crate's output
         // is not promised to be).
@@ -445,18 +465,27 @@ impl Snapshot {
         })
     }
 
-    /// Renames every entity to its slot (index = slot, generation 0): the same state spawned
-    /// with other ids (a plugin that adds a resource shifts every id after it) has the
-    /// same digest. An entity that names no slot keeps its id.
-    fn rename_by_slot(&mut self) {
-        let slots: HashMap<Entity, Entity> = self
+    /// Renames every entity to its rank in id order (index = rank, generation 0) and moves
+    /// its values to that slot. An entity that names no slot keeps its id.
+    fn rename_by_rank(&mut self) {
+        let mut order: Vec<u32> = (0..self.entities.len() as u32).collect();
+        order.sort_by_key(|&slot| self.entities[slot as usize]);
+        let mut to = vec![0; order.len()];
+        for (rank, &slot) in order.iter().enumerate() {
+            to[slot as usize] = rank as u32;
+        }
+        let ranks: HashMap<Entity, Entity> = self
             .entities
             .iter()
-            .enumerate()
-            .filter_map(|(i, &e)| Some((e, Entity::from_raw_u32(i as u32)?)))
+            .zip(&to)
+            .filter_map(|(&e, &rank)| Some((e, Entity::from_raw_u32(rank)?)))
             .collect();
-        let f = |e: Entity| slots.get(&e).copied().unwrap_or(e);
-        self.entities.iter_mut().for_each(|e| *e = f(*e));
+        let f = |e: Entity| ranks.get(&e).copied().unwrap_or(e);
+        self.columns.reslot(&to);
+        self.entities = order
+            .iter()
+            .map(|&slot| f(self.entities[slot as usize]))
+            .collect();
         self.columns.rename(&f);
         if let Some(c) = &mut self.contacts {
             c.rename(f);
@@ -516,7 +545,7 @@ impl Snapshot {
         if (payload.len() as u64) < len {
             return fail(SnapshotError::Truncated {
                 len: bytes.len(),
-                expected: HEADER as u64 + len,
+                expected: (HEADER as u64).saturating_add(len),
             });
         }
         let payload = &payload[..len as usize];

@@ -259,7 +259,7 @@ impl TetMesh {
                             let kind: u32 = l.number(line, f.get(1), "element type")?;
                             let tags: usize = l.number(line, f.get(2), "tag count")?;
                             if kind == 4 || kind == 11 {
-                                let start = 3 + tags;
+                                let start = tags.saturating_add(3);
                                 tets.push(corners(&l, line, &ids, f.get(start..).unwrap_or(&[]))?);
                                 tet_lines.push(line);
                             }

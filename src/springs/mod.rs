@@ -233,19 +233,27 @@ impl Spring {
 }
 
 fn validate_spring(mut world: DeferredWorld, ctx: HookContext) {
+    if world.contains_resource::<crate::core::restore::Restoring>() {
+        return;
+    }
     let Some(spring) = world.get::<Spring>(ctx.entity).copied() else {
         return;
     };
-    let mut result = spring.check();
-    for e in [spring.a, spring.b] {
-        if result.is_ok() && world.get::<Position>(e).is_none() {
-            result = Err(Error::MissingEntity(e));
-        }
-    }
-    if let Err(err) = result {
+    if let Err(err) = spring.check().and_then(|()| ends_exist(&world, &spring)) {
         world.commands().entity(ctx.entity).insert(Quarantined {
             reason: QuarantineReason::InvalidInput(err),
         });
+    }
+}
+
+/// Both ends of `spring` are bodies (they have a [`Position`]).
+pub(crate) fn ends_exist(world: &World, spring: &Spring) -> Result<(), Error> {
+    match [spring.a, spring.b]
+        .into_iter()
+        .find(|&e| world.get::<Position>(e).is_none())
+    {
+        Some(e) => Err(Error::MissingEntity(e)),
+        None => Ok(()),
     }
 }
 

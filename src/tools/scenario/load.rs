@@ -48,20 +48,12 @@ fn options() -> ron::Options {
     )
 }
 
-/// Where a piece of the file starts: 1-based line and column.
-fn locate(src: &str, piece: &str) -> (usize, usize) {
-    let offset = (piece.as_ptr() as usize)
-        .saturating_sub(src.as_ptr() as usize)
-        .min(src.len());
-    let before = &src[..offset];
-    let line = before.matches('\n').count() + 1;
-    let column = before.len() - before.rfind('\n').map_or(0, |i| i + 1) + 1;
-    (line, column)
-}
-
 struct Reader<'a> {
     src: &'a str,
     file: String,
+    /// The byte offset of every line's start, so that finding a piece's line is a binary
+    /// search (a scan from the top for each entry made reading quadratic in the file).
+    line_starts: Vec<usize>,
 }
 
 impl<'a> Reader<'a> {
@@ -74,15 +66,25 @@ impl<'a> Reader<'a> {
         }
     }
 
+    /// Where a piece of the file starts: 1-based line and column (in bytes).
+    fn locate(&self, piece: &str) -> (usize, usize) {
+        let offset = (piece.as_ptr() as usize)
+            .saturating_sub(self.src.as_ptr() as usize)
+            .min(self.src.len());
+        let line = self.line_starts.partition_point(|&start| start <= offset);
+        let start = self.line_starts[line.saturating_sub(1)];
+        (line, offset - start + 1)
+    }
+
     /// Parses one raw piece; a syntax error's position is moved from the piece to the file.
     fn parse<T: for<'de> Deserialize<'de>>(
         &self,
         raw: &RawValue,
     ) -> Result<(T, usize), ScenarioError> {
         let text = raw.get_ron();
-        let (line, column) = locate(self.src, text);
+        let (line, column) = self.locate(text);
         let trimmed = text.trim_start();
-        let (item_line, _) = locate(self.src, trimmed);
+        let (item_line, _) = self.locate(trimmed);
         options()
             .from_str::<T>(text)
             .map(|v| (v, item_line))
@@ -103,7 +105,7 @@ fn members(spawn: &Spawn) -> usize {
     match spawn {
         Spawn::Rope { nodes, .. } => *nodes,
         Spawn::Column { n } => *n,
-        Spawn::Pyramid { layers } => layers * (layers + 1) / 2,
+        Spawn::Pyramid { layers } => layers.saturating_mul(layers.saturating_add(1)) / 2,
         _ => 1,
     }
 }
@@ -122,6 +124,9 @@ pub(super) fn load(src: &str, file: &str) -> Result<Scenario, ScenarioError> {
     let r = Reader {
         src,
         file: file.to_owned(),
+        line_starts: std::iter::once(0)
+            .chain(src.match_indices('\n').map(|(i, _)| i + 1))
+            .collect(),
     };
     let raw: RawFile = options().from_str(src).map_err(|e| {
         r.error(
@@ -376,6 +381,20 @@ pub(super) fn load(src: &str, file: &str) -> Result<Scenario, ScenarioError> {
         trace.push(sel);
     }
 
+    let rows = (trace.len() as u64).saturating_mul(steps.saturating_add(1));
+    if rows > super::MAX_TRACE_ROWS {
+        return Err(bad(
+            trace_line(src),
+            format!(
+                "tracing {} names over {} steps is {rows} rows, more than {} (shorten the \
+                 duration or trace fewer names)",
+                trace.len(),
+                steps + 1,
+                super::MAX_TRACE_ROWS
+            ),
+        ));
+    }
+
     let hash = match &raw.hash {
         Some(h) => Some(
             u64::from_str_radix(h.trim_start_matches("0x"), 16).map_err(|_| {
@@ -504,8 +523,8 @@ fn selector_at(
     let index = match index {
         None => None,
         Some(i) => {
-            let n = life.members as i64;
-            let k = if i < 0 { n + i } else { i };
+            let n = i64::try_from(life.members).unwrap_or(i64::MAX);
+            let k = if i < 0 { n.saturating_add(i) } else { i };
             if k < 0 || k >= n {
                 return Err(r.error(
                     line,

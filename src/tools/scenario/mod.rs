@@ -58,6 +58,12 @@ pub use run::RunOptions;
 use expr::Expr;
 use format::{Action, Check, EntityEntry, Settings};
 
+/// The most rows a run traces in all (traced names × steps): a trace row is 64 bytes, so
+/// this bounds a run's traces at 256 MB. A file whose traces would pass it is refused when
+/// read ([`ScenarioErrorKind::BadValue`]), as is a traced run ([`RunOptions::trace_all`])
+/// that would.
+pub const MAX_TRACE_ROWS: u64 = 1 << 22;
+
 /// Each entry's name and the entities it spawned, sorted by name.
 pub type NamedEntities = Vec<(String, Vec<bevy_ecs::entity::Entity>)>;
 

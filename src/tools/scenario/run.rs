@@ -137,6 +137,18 @@ pub(super) fn run(s: &Scenario, options: &mut RunOptions) -> Result<Report, Scen
     } else {
         s.trace.clone()
     };
+    let rows = (traced.len() as u64).saturating_mul(s.steps.saturating_add(1));
+    if rows > super::MAX_TRACE_ROWS {
+        return Err(s.error(
+            0,
+            ScenarioErrorKind::BadValue(format!(
+                "tracing every name ({}) over {} steps is {rows} rows, more than {}",
+                traced.len(),
+                s.steps + 1,
+                super::MAX_TRACE_ROWS
+            )),
+        ));
+    }
     let mut traces: Vec<Trace> = traced
         .iter()
         .map(|t| Trace {

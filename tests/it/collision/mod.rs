@@ -1,6 +1,7 @@
 //! Contacts and queries: solver behaviour on stacks and impacts, tunnelling, recycling, the broad phase and spatial queries.
 
 mod broad_phase_hears_pose_changes;
+mod collider_parts_are_never_lost_or_nan;
 mod compound_part_frames;
 mod contacts_against_closed_forms;
 mod contacts_end_with_the_last_collider;

@@ -3,6 +3,7 @@
 mod bad_input;
 mod bad_input_caught;
 mod bounded_clock;
+mod file_counts_never_overflow;
 mod fuzz;
 mod fuzz_findings;
 mod harness;
