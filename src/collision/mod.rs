@@ -59,6 +59,7 @@
 
 mod attach;
 pub(crate) mod broad_phase;
+pub mod coincident;
 pub(crate) mod lanes;
 pub(crate) mod narrow_phase;
 pub(crate) mod nodes;

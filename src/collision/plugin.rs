@@ -26,6 +26,7 @@ impl WorldPlugin for CollisionPlugin {
             (
                 correct_contact_settings,
                 super::attach::refresh_written_parts,
+                super::coincident::forget_recent_spawns,
             )
                 .in_set(crate::core::schedule::PrepareSystems::Inputs),
         );
@@ -47,6 +48,8 @@ impl WorldPlugin for CollisionPlugin {
         world.add_observer(crate::collision::broad_phase::on_body_inserted);
         world.add_observer(crate::collision::broad_phase::on_body_removed);
         world.add_observer(super::attach::on_body_inserted);
+        crate::core::restore::init::<super::coincident::RecentSpawns>(world);
+        world.add_observer(super::coincident::separate_coincident_spawns);
         world.add_observer(super::attach::on_child_of_discarded);
         world.add_observer(super::attach::on_child_of_inserted);
         add_own_systems(

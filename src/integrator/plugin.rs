@@ -69,7 +69,16 @@ impl WorldPlugin for IntegratorPlugin {
         add_own_systems(
             world,
             PhysicsSchedule,
-            quarantine_runaway_velocities.in_set(PrepareSystems::Guard),
+            (
+                quarantine_runaway_velocities.in_set(PrepareSystems::Guard),
+                // Again at the end, over what the step itself wrote (a contact or a spring
+                // can leave a body past the guard after its integrator's check): the state
+                // a step leaves, and so a snapshot of it, holds no unreported runaway.
+                // Before, the next step caught it by its change tick, which a restored copy
+                // does not have, and the copy went on differently.
+                quarantine_runaway_velocities
+                    .in_set(crate::core::schedule::FinishSystems::Diagnostics),
+            ),
         );
         add_own_systems(
             world,

@@ -363,9 +363,23 @@ impl Snapshot {
         fresh.sort_unstable();
         let map: columns::Map = sorted.iter().copied().zip(fresh.iter().copied()).collect();
         let mut columns = self.columns.clone();
+        let max_distance = self
+            .resources
+            .divergence_guard
+            .map_or(DivergenceGuard::default().max_distance, |g| g.max_distance);
         let checked = columns
             .check_and_map(self.entities.len(), &map)
-            .and_then(|()| columns.check_meshes());
+            .and_then(|()| columns.check_meshes())
+            .and_then(|()| match columns.body_past(max_distance) {
+                Some((slot, distance)) => Err(SnapshotError::Invalid {
+                    slot,
+                    component: "Position",
+                    error: format!(
+                        "a moving body {distance} m from the origin, past the divergence guard's {max_distance} m"
+                    ),
+                }),
+                None => Ok(()),
+            });
         let contacts = match &self.contacts {
             Some(record) => Contacts::from_record(record.clone(), |e| map.get(&e).copied())
                 .map(Some)
@@ -405,6 +419,12 @@ impl Snapshot {
             let Some(spring) = world.get::<crate::springs::Spring>(id).copied() else {
                 continue;
             };
+            if world
+                .get::<crate::core::quarantine::Quarantined>(id)
+                .is_some()
+            {
+                continue;
+            }
             if let Err(error) = crate::springs::ends_exist(world, &spring) {
                 world
                     .entity_mut(id)

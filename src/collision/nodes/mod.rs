@@ -172,6 +172,14 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
             if moving_bad || !(x.0.is_finite() && q.0.is_finite()) {
                 continue;
             }
+            // A friction game code wrote (−∞, NaN) is the collider's fault: it leaves,
+            // named by its error, as the rigid contacts' check does; the nodes do not read it.
+            if let Err(err) = crate::core::quarantine::Validate::validate(friction) {
+                commands.entity(entity).try_insert(Quarantined {
+                    reason: crate::core::quarantine::QuarantineReason::InvalidInput(err),
+                });
+                continue;
+            }
             let pose = crate::collision::shape_pose(x.0, q.0, com);
             let mut rigid = side_of(x, q, d);
             // Guarded as pair geometry is (parry asserts on some degenerate inputs): a mesh

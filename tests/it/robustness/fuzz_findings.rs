@@ -318,3 +318,73 @@ fn a_body_spun_past_the_guard_is_quarantined_as_spun_out() {
         q.reason
     );
 }
+
+/// Found by the long fuzz (seed 1, case 3117): a crate whose friction game code set to −∞
+/// slid into a cloth. The node contacts read the friction unchecked, so a node's velocity
+/// turned NaN after the mesh's own check had run, and the cloth was caught a step late (a
+/// silent NaN for a step) and removed for the crate's fault. Now the node contacts check
+/// the friction as the rigid contacts do: the crate leaves, named by its error, and the
+/// cloth runs on.
+#[test]
+fn a_bad_friction_quarantines_the_collider_not_the_cloth_it_touches() {
+    use glam::Vec3;
+    use harness::{Meddle, Tally, Thing, WorldCase};
+    let case = WorldCase {
+        integrator: 0,
+        substeps: 1,
+        things: vec![
+            Thing::Cloth(Vec3::new(0.0, 4.0, 0.0), 5, 0.48538855),
+            Thing::Crate(
+                Vec3::new(2.700706, 4.0, 0.0),
+                Vec3::new(-1.5741526, 0.0, 0.0),
+                Vec3::new(0.02, 0.41757783, 0.8432839),
+            ),
+        ],
+        meddles: vec![(0, Meddle::SetFriction(1, f32::NEG_INFINITY))],
+        steps: 30,
+    };
+    let mut t = Tally::default();
+    harness::run_world(&case, &mut t, true);
+    assert_eq!(
+        (t.panics, t.silent, t.snapshot_mismatches),
+        (0, 0, 0),
+        "{t:?}"
+    );
+    assert_eq!(t.quarantines, 1, "the crate alone: {t:?}");
+}
+
+/// Found by the long fuzz (seed 1, case 3927): a box spun to 184 rad/s under explicit Euler
+/// hit the ground and left the step at 17.5 km/s, past the guard, after its integrator's
+/// check. The next step's check caught it by its change tick, which a restored copy does
+/// not carry, so the copy moved it 10 m before catching it another way. The check now runs
+/// at the end of each step as well: a saved state holds no unreported runaway, and the
+/// copy continues bit for bit.
+#[test]
+fn a_runaway_left_by_the_step_is_caught_before_a_snapshot_sees_it() {
+    use glam::Vec3;
+    use harness::{Meddle, Tally, Thing, WorldCase};
+    let case = WorldCase {
+        integrator: 1,
+        substeps: 3,
+        things: vec![
+            Thing::Spinner(
+                Vec3::new(0.0, 6.628043, 0.0),
+                Vec3::new(183.98468, 103.29238, -120.741035),
+            ),
+            Thing::Spinner(
+                Vec3::new(-2.0584438, 1.3997538, 2.4911897),
+                Vec3::new(0.0, -67.481964, 0.0),
+            ),
+        ],
+        meddles: vec![(0, Meddle::Despawn(11965055612869185313))],
+        steps: 34,
+    };
+    let mut t = Tally::default();
+    harness::run_world(&case, &mut t, true);
+    assert_eq!(
+        (t.panics, t.silent, t.snapshot_mismatches),
+        (0, 0, 0),
+        "{t:?}"
+    );
+    assert_eq!(t.quarantines, 1, "{t:?}");
+}

@@ -219,7 +219,7 @@ fn constructors(
 
 /// A runner whose cases follow from `seed`: the same seed, the same inputs (CI runs are
 /// reproducible; the long run takes a seed to explore further).
-fn runner(cases: u32, seed: u64) -> TestRunner {
+pub fn runner(cases: u32, seed: u64) -> TestRunner {
     let mut bytes = [0u8; 32];
     for (i, chunk) in bytes.chunks_mut(8).enumerate() {
         chunk.copy_from_slice(
@@ -278,7 +278,7 @@ fn a_failing_case_is_shrunk_and_reported() {
 }
 
 /// The minimal failing case of a run, as text.
-fn shrunk<T: std::fmt::Debug>(result: Result<(), TestError<T>>) -> Option<String> {
+pub fn shrunk<T: std::fmt::Debug>(result: Result<(), TestError<T>>) -> Option<String> {
     match result {
         Ok(()) => None,
         Err(TestError::Fail(reason, minimal)) => {
@@ -299,6 +299,8 @@ pub enum Thing {
     Rope(Vec3, Vec3, usize, f32, f32),
     Cloth(Vec3, usize, f32),
     Jelly(Vec3, f32, bool),
+    /// A static bumpy triangle-mesh floor (8 × 8 m, bumps of the given height) at a height.
+    MeshFloor(f32, f32),
 }
 
 /// Something game code does in the middle of a run.
@@ -312,6 +314,14 @@ pub enum Meddle {
     SetRestitution(usize, f32),
     Target(usize, Vec3),
     Settings(f32),
+    /// Game code empties a mesh's nodes.
+    EmptyNodes(usize),
+    /// Game code replaces a mesh's nodes with `n` others (fewer or more).
+    ResizeNodes(usize, usize),
+    /// Game code inserts a soft body of another mesh (8 cells) on an entity.
+    SwapSoftBody(usize),
+    /// Game code inserts a spring between two picked entities on a third.
+    Respring(usize, usize, usize),
 }
 
 fn sane_vec(r: f32) -> impl Strategy<Value = Vec3> {
@@ -344,6 +354,7 @@ fn thing() -> impl Strategy<Value = Thing> {
         (at(), 2usize..7, 0.05f32..0.5).prop_map(|(x, n, s)| Thing::Cloth(x, n, s)),
         (at(), prop_oneof![1e3f32..1e6, 1e8f32..1e10], any::<bool>())
             .prop_map(|(x, e, i)| Thing::Jelly(x, e, i)),
+        (-1.0f32..2.0, 0.0f32..0.5).prop_map(|(y, b)| Thing::MeshFloor(y, b)),
     ]
 }
 
@@ -357,6 +368,11 @@ fn meddle() -> impl Strategy<Value = Meddle> {
         (any::<usize>(), wild()).prop_map(|(i, f)| Meddle::SetRestitution(i, f)),
         (any::<usize>(), wild_vec()).prop_map(|(i, v)| Meddle::Target(i, v)),
         wild().prop_map(Meddle::Settings),
+        any::<usize>().prop_map(Meddle::EmptyNodes),
+        (any::<usize>(), 0usize..40).prop_map(|(i, n)| Meddle::ResizeNodes(i, n)),
+        any::<usize>().prop_map(Meddle::SwapSoftBody),
+        (any::<usize>(), any::<usize>(), any::<usize>())
+            .prop_map(|(i, a, b)| Meddle::Respring(i, a, b)),
     ]
 }
 
@@ -427,6 +443,29 @@ fn spawn(world: &mut World, thing: &Thing) -> hooke::Result<Vec<Entity>> {
                 .nodes
         }
         Thing::Cloth(x, n, s) => vec![ClothBuilder::new(x, n, n, s).spawn(world)?],
+        Thing::MeshFloor(y, bump) => {
+            let n = 9u32;
+            let vertices: Vec<Vec3> = (0..n * n)
+                .map(|k| {
+                    let (i, j) = ((k % n) as f32, (k / n) as f32);
+                    let h = bump * ((i * 1.7).sin() * (j * 2.3).cos());
+                    Vec3::new(i - 4.0, y + h, j - 4.0)
+                })
+                .collect();
+            let indices = (0..(n - 1) * (n - 1))
+                .flat_map(|c| {
+                    let (i, j) = (c % (n - 1), c / (n - 1));
+                    let k = j * n + i;
+                    [[k, k + n, k + 1], [k + 1, k + n, k + n + 1]]
+                })
+                .collect();
+            let floor = Collider::trimesh(vertices, indices)?;
+            vec![
+                world
+                    .spawn((RigidBody::Static, floor, Position::default()))
+                    .id(),
+            ]
+        }
         Thing::Jelly(x, young, implicit) => {
             let mesh = TetMesh::cuboid(Vec3::splat(0.4), [1, 1, 1], CellSplit::Six)?;
             let (nodes, body) = SoftBody::build(
@@ -454,7 +493,11 @@ fn apply(world: &mut World, all: &[Entity], m: &Meddle) {
         | Meddle::Kick(i, _)
         | Meddle::SetFriction(i, _)
         | Meddle::SetRestitution(i, _)
-        | Meddle::Target(i, _) => pick(*i),
+        | Meddle::Target(i, _)
+        | Meddle::EmptyNodes(i)
+        | Meddle::ResizeNodes(i, _)
+        | Meddle::SwapSoftBody(i)
+        | Meddle::Respring(i, _, _) => pick(*i),
     }) else {
         return;
     };
@@ -504,6 +547,46 @@ fn apply(world: &mut World, all: &[Entity], m: &Meddle) {
                 t.insert(RestitutionThreshold(v));
             }
         }
+        Meddle::EmptyNodes(_) => {
+            if let Some(mut n) = world.get_mut::<Nodes>(e) {
+                *n = Nodes::new();
+            }
+        }
+        Meddle::ResizeNodes(_, count) => {
+            if let Some(mut n) = world.get_mut::<Nodes>(e) {
+                let mut other = Nodes::with_capacity(count);
+                for i in 0..count {
+                    let x = n
+                        .positions()
+                        .get(i)
+                        .map_or(Vec3::Y * i as f32 * 0.1, |&x| x.into());
+                    let _ = other.push(x, Vec3::ZERO, 0.1);
+                }
+                *n = other;
+            }
+        }
+        Meddle::SwapSoftBody(_) => {
+            let built = TetMesh::cuboid(Vec3::new(0.8, 0.4, 0.4), [2, 2, 2], CellSplit::Six)
+                .and_then(|mesh| {
+                    SoftBody::build(
+                        &mesh,
+                        Vec3::Y * 3.0,
+                        Material::new(1e5, 0.3, 1000.0)?,
+                        StrainModel::Corotated,
+                    )
+                });
+            if let (Ok((_, body)), Ok(mut r)) = (built, world.get_entity_mut(e)) {
+                r.insert(body);
+            }
+        }
+        Meddle::Respring(_, a, b) => {
+            if let (Some(a), Some(b)) = (pick(a), pick(b))
+                && let Ok(spring) = Spring::from_hooke(a, b, 1.0, 100.0, 1.0)
+                && let Ok(mut r) = world.get_entity_mut(e)
+            {
+                r.insert(spring);
+            }
+        }
     }
 }
 
@@ -539,14 +622,21 @@ fn bits(world: &World, e: Entity) -> Vec<u32> {
 const BOUND: f32 = 1e6;
 
 /// Counts the live bodies of `world` whose state is non-finite or out of bounds.
-fn silent_bad(world: &mut World) -> usize {
+pub fn silent_bad(world: &mut World) -> usize {
     let mut bad = 0;
     let verbose = std::env::var_os("HOOKE_FUZZ_VERBOSE").is_some();
-    let mut q = world
-        .query_filtered::<(Entity, &Position, Option<&LinearVelocity>), Without<Quarantined>>();
-    for (e, x, v) in q.iter(world) {
+    let mut q = world.query_filtered::<(
+        Entity,
+        &Position,
+        Option<&LinearVelocity>,
+        Option<&RigidBody>,
+    ), Without<Quarantined>>();
+    for (e, x, v, kind) in q.iter(world) {
         let v = v.map_or(Vec3A::ZERO, |v| v.0);
-        if !(x.0.is_finite() && v.is_finite() && x.0.abs().max_element() < BOUND) {
+        // A static body stays where its input put it (an edited file may put it far away):
+        // far is not a blow-up there, only non-finite is.
+        let far = kind != Some(&RigidBody::Static) && x.0.abs().max_element() > BOUND;
+        if !(x.0.is_finite() && v.is_finite()) || far {
             if verbose {
                 println!("silently bad: {e} x {:?} v {v:?}", x.0);
             }
@@ -555,12 +645,12 @@ fn silent_bad(world: &mut World) -> usize {
     }
     let mut q = world.query_filtered::<(Entity, &Nodes), Without<Quarantined>>();
     for (e, n) in q.iter(world) {
-        if !n.is_finite() || n.positions().iter().any(|x| x.abs().max_element() >= BOUND) {
+        if !n.is_finite() || n.positions().iter().any(|x| x.abs().max_element() > BOUND) {
             if verbose {
                 let bad = n
                     .positions()
                     .iter()
-                    .position(|x| !x.is_finite() || x.abs().max_element() >= BOUND);
+                    .position(|x| !x.is_finite() || x.abs().max_element() > BOUND);
                 println!(
                     "silently bad mesh: {e} max speed {}, node {bad:?} at {:?} of {}",
                     n.max_speed(),
@@ -574,31 +664,52 @@ fn silent_bad(world: &mut World) -> usize {
     bad
 }
 
+/// The world of `case` before its first step: the ground and its things (those whose
+/// constructors accepted the case's numbers).
+fn build(case: &WorldCase) -> (World, Vec<Entity>) {
+    let integrator = [
+        Integrator::SymplecticEuler,
+        Integrator::ExplicitEuler,
+        Integrator::VelocityVerlet,
+        Integrator::Rk4,
+        Integrator::ImplicitEuler,
+    ][case.integrator];
+    let mut world = scenes::world_with(
+        1.0 / 60.0,
+        case.substeps,
+        integrator,
+        Vec3::new(0.0, -9.81, 0.0),
+    )
+    .expect("valid settings");
+    scenes::ground(&mut world).expect("ground");
+    let mut all = Vec::new();
+    for t in &case.things {
+        if let Ok(es) = spawn(&mut world, t) {
+            all.extend(es);
+        }
+    }
+    (world, all)
+}
+
+/// The world of `case` after its steps and meddling, with no checks (a state to save).
+pub fn play(case: &WorldCase) -> World {
+    let (mut world, all) = build(case);
+    for step in 0..case.steps {
+        for (at, m) in &case.meddles {
+            if *at == step {
+                apply(&mut world, &all, m);
+            }
+        }
+        world.step_physics();
+    }
+    world
+}
+
 /// Runs one world; adds to the tally.
 pub fn run_world(case: &WorldCase, tally: &mut Tally, check_snapshot: bool) {
     tally.inputs += 1;
     let outcome = catch_unwind(AssertUnwindSafe(|| {
-        let integrator = [
-            Integrator::SymplecticEuler,
-            Integrator::ExplicitEuler,
-            Integrator::VelocityVerlet,
-            Integrator::Rk4,
-            Integrator::ImplicitEuler,
-        ][case.integrator];
-        let mut world = scenes::world_with(
-            1.0 / 60.0,
-            case.substeps,
-            integrator,
-            Vec3::new(0.0, -9.81, 0.0),
-        )
-        .expect("valid settings");
-        scenes::ground(&mut world).expect("ground");
-        let mut all = Vec::new();
-        for t in &case.things {
-            if let Ok(es) = spawn(&mut world, t) {
-                all.extend(es);
-            }
-        }
+        let (mut world, all) = build(case);
         let mut silent = 0;
         for step in 0..case.steps {
             for (at, m) in &case.meddles {
@@ -623,12 +734,28 @@ pub fn run_world(case: &WorldCase, tally: &mut Tally, check_snapshot: bool) {
             copy.add_physics(PhysicsPlugins);
             let map = match read.restore(&mut copy) {
                 Ok(map) => map,
-                Err(hooke::snapshot::SnapshotError::Invalid { .. }) => {
+                Err(e @ hooke::snapshot::SnapshotError::Invalid { .. }) => {
+                    if std::env::var_os("HOOKE_FUZZ_VERBOSE").is_some() {
+                        println!("refused: {e}");
+                    }
                     return (silent, quarantined, false, true);
                 }
                 Err(e) => panic!("own snapshot not restored: {e}"),
             };
+            let trace = std::env::var_os("HOOKE_FUZZ_SNAPSHOT_TRACE").is_some();
             for _ in 0..10 {
+                if trace {
+                    for &e in snapshot.entities() {
+                        let c = map.get(e).unwrap();
+                        println!(
+                            "{e}: {:?} {:?} | {:?} {:?}",
+                            world.get::<Position>(e).map(|x| x.0),
+                            world.get::<Quarantined>(e).map(|q| q.reason.clone()),
+                            copy.get::<Position>(c).map(|x| x.0),
+                            copy.get::<Quarantined>(c).map(|q| q.reason.clone())
+                        );
+                    }
+                }
                 world.step_physics();
                 copy.step_physics();
             }
@@ -665,8 +792,51 @@ pub fn run_world(case: &WorldCase, tally: &mut Tally, check_snapshot: bool) {
     }
 }
 
+/// Which cases of a run to run and whether to announce each (`case K` on stdout, for a
+/// supervising parent; see `supervisor`).
+#[derive(Debug, Default, Clone, Copy)]
+pub struct Cases {
+    /// Cases before this one are generated and skipped.
+    pub skip: u32,
+    /// Print `case K` before case K.
+    pub announce: bool,
+    next: u32,
+}
+
+impl Cases {
+    /// From case `skip` on, announced.
+    pub fn announced_from(skip: u32) -> Self {
+        Self {
+            skip,
+            announce: true,
+            next: 0,
+        }
+    }
+
+    /// Whether to run the next generated case (not a shrinking rerun).
+    pub fn take(&mut self) -> bool {
+        let k = self.next;
+        self.next += 1;
+        if k < self.skip {
+            return false;
+        }
+        if self.announce {
+            use std::io::Write;
+            println!("case {k}");
+            let _ = std::io::stdout().flush();
+        }
+        true
+    }
+}
+
 /// Runs `cases` random worlds from `seed`; returns the tally.
 pub fn fuzz_worlds(cases: u32, seed: u64, check_snapshot: bool) -> Tally {
+    fuzz_worlds_of(cases, seed, check_snapshot, Cases::default())
+}
+
+/// [`fuzz_worlds`] of some of the cases.
+pub fn fuzz_worlds_of(cases: u32, seed: u64, check_snapshot: bool, which: Cases) -> Tally {
+    let which = std::cell::RefCell::new(which);
     let mut tally = Tally::default();
     let mut runner = runner(cases, seed);
     let mut scratch = Tally::default();
@@ -680,6 +850,9 @@ pub fn fuzz_worlds(cases: u32, seed: u64, check_snapshot: bool) -> Tally {
         }
         let start = std::time::Instant::now();
         let (tally, scratch, failed) = &mut *cell.borrow_mut();
+        if !*failed && !which.borrow_mut().take() {
+            return Ok(());
+        }
         // Shrinking reruns failing cases: they go to a scratch tally (see fuzz_constructors).
         let t: &mut Tally = if *failed { scratch } else { tally };
         let before = (t.panics, t.silent, t.snapshot_mismatches);

@@ -97,3 +97,34 @@ fn a_snapshot_whose_implicit_factor_is_one_number_short_is_refused() {
     println!("{e}");
     assert!(e.contains("implicit factor"), "{e}");
 }
+
+/// Found by the snapshot fuzz: a moving body (here asleep, so no step checks it) edited to
+/// 4·10²¹ m was restored and left there, silently out of the world. No run can leave a body
+/// there (the guard quarantines it past 10⁶ m), so a file that does is refused.
+#[test]
+fn a_moving_body_past_the_guard_distance_is_refused() {
+    let mut w = World::new();
+    w.add_physics(PhysicsPlugins);
+    let body = scenes::dynamic_box(&mut w, Vec3::splat(0.5), Vec3::new(123.25, 5.0, 0.0)).unwrap();
+    w.entity_mut(body).insert(Sleeping);
+    let text = Snapshot::capture(&w).unwrap().to_ron().unwrap();
+    assert!(text.contains("123.25"), "the body's x is written as given");
+    let read = Snapshot::from_ron(&text.replacen("123.25", "-4.289195e21", 1)).unwrap();
+    let mut copy = World::new();
+    copy.add_physics(PhysicsPlugins);
+    let error = read.restore(&mut copy).expect_err("refused").to_string();
+    assert!(error.contains("past the divergence guard"), "{error}");
+    // A static body may sit anywhere its constructor accepts.
+    let mut w = World::new();
+    w.add_physics(PhysicsPlugins);
+    w.spawn((
+        RigidBody::Static,
+        Collider::cuboid(1.0, 1.0, 1.0).unwrap(),
+        Position::from(Vec3::new(123.25, 0.0, 0.0)),
+    ));
+    let text = Snapshot::capture(&w).unwrap().to_ron().unwrap();
+    let read = Snapshot::from_ron(&text.replacen("123.25", "4e21", 1)).unwrap();
+    let mut copy = World::new();
+    copy.add_physics(PhysicsPlugins);
+    assert!(read.restore(&mut copy).is_ok());
+}

@@ -5,3 +5,4 @@ mod cli;
 mod corpus;
 mod errors;
 mod hostile_expressions;
+mod large_files_read_in_linear_time;
