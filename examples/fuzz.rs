@@ -12,6 +12,8 @@ mod file_harness;
 mod harness;
 #[path = "../tests/it/robustness/supervisor.rs"]
 mod supervisor;
+#[path = "../tests/it/robustness/world_cases.rs"]
+mod world_cases;
 
 use std::process::Command;
 use std::time::Duration;

@@ -15,8 +15,9 @@ use hooke::tools::scenes;
 /// there unquarantined for 49 steps (the guard checked speed only).
 #[test]
 fn a_body_flung_out_of_the_world_is_quarantined() {
+    use super::world_cases::{Meddle, Thing, WorldCase};
     use glam::Vec3;
-    use harness::{Meddle, Tally, Thing, WorldCase};
+    use harness::Tally;
     let case = WorldCase {
         integrator: 2,
         substeps: 4,
@@ -179,8 +180,9 @@ fn energies_of_large_finite_states_are_finite() {
 /// collider whose state went bad (it is quarantined by its own check).
 #[test]
 fn a_cloth_touching_a_body_gone_bad_is_not_handed_its_nan() {
+    use super::world_cases::{Meddle, Thing, WorldCase};
     use glam::Vec3;
-    use harness::{Meddle, Tally, Thing, WorldCase};
+    use harness::Tally;
     let v = Vec3::new;
     let case = WorldCase {
         integrator: 1,
@@ -240,8 +242,9 @@ fn a_cloth_touching_a_body_gone_bad_is_not_handed_its_nan() {
 /// quarantined as spun out. Fails by the watchdog instead of hanging CI.
 #[test]
 fn a_body_spun_absurdly_fast_does_not_hold_the_step() {
+    use super::world_cases::{Meddle, Thing, WorldCase};
     use glam::Vec3;
-    use harness::{Meddle, Tally, Thing, WorldCase};
+    use harness::Tally;
     let v = Vec3::new;
     let case = WorldCase {
         integrator: 3,
@@ -327,8 +330,9 @@ fn a_body_spun_past_the_guard_is_quarantined_as_spun_out() {
 /// cloth runs on.
 #[test]
 fn a_bad_friction_quarantines_the_collider_not_the_cloth_it_touches() {
+    use super::world_cases::{Meddle, Thing, WorldCase};
     use glam::Vec3;
-    use harness::{Meddle, Tally, Thing, WorldCase};
+    use harness::Tally;
     let case = WorldCase {
         integrator: 0,
         substeps: 1,
@@ -361,8 +365,9 @@ fn a_bad_friction_quarantines_the_collider_not_the_cloth_it_touches() {
 /// copy continues bit for bit.
 #[test]
 fn a_runaway_left_by_the_step_is_caught_before_a_snapshot_sees_it() {
+    use super::world_cases::{Meddle, Thing, WorldCase};
     use glam::Vec3;
-    use harness::{Meddle, Tally, Thing, WorldCase};
+    use harness::Tally;
     let case = WorldCase {
         integrator: 1,
         substeps: 3,

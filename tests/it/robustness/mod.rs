@@ -12,3 +12,4 @@ mod restores_validate;
 mod runaway_velocity_quarantined_first;
 mod sizes_are_bounded;
 mod supervisor;
+mod world_cases;
