@@ -151,7 +151,9 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
             .filter(|f| f.is_factored());
         body.contacts_mut().clear();
         let thickness = body.thickness();
-        let Some((lo, hi)) = n.bounds() else {
+        // Where the nodes were at the substep's start as well (x − h v): a fast node that
+        // crossed a collider within the substep is found by its sweep.
+        let Some((lo, hi)) = swept_bounds(n, h) else {
             continue;
         };
         let (lo, hi) = (lo - Vec3::splat(thickness), hi + Vec3::splat(thickness));
@@ -185,7 +187,7 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
             // Guarded as pair geometry is (parry asserts on some degenerate inputs): a mesh
             // whose contact with this collider fails leaves, named with it.
             let found = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                find_hits(n, c, &pose, q.0, aabb, thickness)
+                find_hits(n, c, &pose, q.0, aabb, thickness, h)
             }));
             let Ok(hits) = found else {
                 commands.entity(mesh).try_insert(Quarantined {
@@ -247,6 +249,38 @@ struct Hit {
     overlap: f32,
 }
 
+/// The bounds of the nodes now and at the substep's start (x − h v).
+fn swept_bounds(n: &Nodes, h: f32) -> Option<(Vec3, Vec3)> {
+    let first = Vec3::from(*n.x.first()?);
+    Some(
+        n.x.iter()
+            .zip(&n.v)
+            .fold((first, first), |(lo, hi), (x, v)| {
+                let (x, back) = (Vec3::from(*x), Vec3::from(*x - *v * h));
+                (lo.min(x).min(back), hi.max(x).max(back))
+            }),
+    )
+}
+
+/// The surface a fast node crossed within the substep: its sweep from `start` to `end` (in
+/// the collider's frame, `start` outside the shape) enters the shape. The hit's outward
+/// normal and the overlap that puts the node back `thickness` outside the entry point.
+fn crossed(
+    shape: &dyn parry3d::shape::Shape,
+    start: Vec3,
+    end: Vec3,
+    thickness: f32,
+) -> Option<(Vec3, f32)> {
+    if shape.contains_local_point(start) {
+        return None;
+    }
+    let ray = parry3d::query::Ray::new(start, end - start);
+    let hit = shape.cast_local_ray_and_get_normal(&ray, 1.0, true)?;
+    let n = hit.normal;
+    let entry = ray.point_at(hit.time_of_impact);
+    (n.is_finite() && n != Vec3::ZERO).then(|| (n, thickness + (entry - end).dot(n)))
+}
+
 fn find_hits(
     n: &Nodes,
     collider: &Collider,
@@ -254,6 +288,7 @@ fn find_hits(
     rotation: Quat,
     aabb: &ColliderAabb,
     thickness: f32,
+    h: f32,
 ) -> Vec<Hit> {
     let shape = collider.shape();
     let inverse = pose.inverse();
@@ -263,15 +298,33 @@ fn find_hits(
             continue;
         }
         let p = Vec3::from(n.x[i]);
-        if (p + Vec3::splat(thickness)).cmplt(aabb.min).any()
-            || (p - Vec3::splat(thickness)).cmpgt(aabb.max).any()
+        let step = Vec3::from(n.v[i]) * h;
+        let back = p - step;
+        let (lo, hi) = (p.min(back), p.max(back));
+        if (hi + Vec3::splat(thickness)).cmplt(aabb.min).any()
+            || (lo - Vec3::splat(thickness)).cmpgt(aabb.max).any()
         {
             continue;
         }
         let local = inverse * p;
-        if !local.is_finite() {
+        if !local.is_finite() || !step.is_finite() {
             // A node gone non-finite is caught by its own check; projecting it would trip
             // parry's asserts (NaN against a capsule of half height 0).
+            continue;
+        }
+        // A node that moved more than the contact distance this substep may have crossed
+        // the surface, or a thin shape whole: the sweep's entry decides, since a point test
+        // at its end would push it out of the far side (a soft cube at 300 m/s under
+        // implicit integration went through the ground).
+        if step.length_squared() > thickness * thickness
+            && let Some((normal_local, overlap)) =
+                crossed(&**shape, inverse * back, local, thickness)
+        {
+            hits.push(Hit {
+                node: i,
+                normal: rotation * normal_local,
+                overlap,
+            });
             continue;
         }
         let solid = shape.project_local_point(local, true);

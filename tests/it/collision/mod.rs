@@ -8,6 +8,7 @@ mod contacts_end_with_the_last_collider;
 mod deep_overlap_recovery;
 mod energy_in_any_order;
 mod every_integrator_keeps_resting_contact;
+mod fast_meshes_do_not_tunnel;
 mod fast_spin_stays_above_ground;
 mod landing_stays_in_place;
 mod mesh_contacts;
