@@ -101,7 +101,7 @@ impl<'a> Reader<'a> {
 }
 
 /// How many entities an entry spawns, known before anything runs.
-fn members(spawn: &Spawn) -> usize {
+pub(super) fn members(spawn: &Spawn) -> usize {
     match spawn {
         Spawn::Rope { nodes, .. } => *nodes,
         Spawn::Column { n } => *n,

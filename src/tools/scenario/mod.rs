@@ -232,6 +232,21 @@ impl Scenario {
         self.steps
     }
 
+    /// How many entities its entries and spawn actions make in all (a column of n boxes
+    /// counts n): with [`Scenario::steps`] and the substeps, what a run will cost.
+    #[must_use]
+    pub fn entities_spawned(&self) -> u64 {
+        let entries = self.entities.iter().map(|e| &e.item.spawn);
+        let actions = self.timeline.iter().filter_map(|a| match &a.item {
+            Action::Spawn { spawn, .. } => Some(spawn),
+            _ => None,
+        });
+        entries
+            .chain(actions)
+            .map(|s| load::members(s) as u64)
+            .fold(0, u64::saturating_add)
+    }
+
     /// The world settings.
     #[must_use]
     pub fn settings(&self) -> &Settings {

@@ -260,18 +260,31 @@ pub fn corpus() -> Vec<(String, String)> {
         .collect()
 }
 
-/// The most steps × substeps an edited scenario is run for (a wild duration or substep
-/// count is read and checked, and run only up to this budget).
-const RUN_BUDGET: u64 = 4000;
+/// The most steps × substeps × entities an edited scenario is run for (a wild duration,
+/// substep count or column height is read and checked, and run only up to this budget: a
+/// column of 10⁶ boxes for 5 s is slow, not stuck).
+const RUN_BUDGET: u64 = 200_000;
 
 /// One scenario case: a corpus file edited, read and (if cheap enough) run.
 pub fn run_scenario(file: &(String, String), edit: &Edit, tally: &mut Tally) {
     let outcome = catch_unwind(AssertUnwindSafe(|| {
         let text = edit_text(&file.1, edit);
+        let trace = std::env::var_os("HOOKE_FUZZ_TRACE").is_some();
+        if trace {
+            println!("{}:\n{text}", file.0);
+        }
         let scenario = Scenario::from_str(&text, &file.0).ok()?;
         let cost = scenario
             .steps()
-            .saturating_mul(u64::from(scenario.settings().substeps));
+            .saturating_mul(u64::from(scenario.settings().substeps))
+            .saturating_mul(scenario.entities_spawned().max(1));
+        if trace {
+            println!(
+                "read: {} steps x {}",
+                scenario.steps(),
+                scenario.settings().substeps
+            );
+        }
         if cost > RUN_BUDGET {
             return Some(0);
         }
