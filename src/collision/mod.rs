@@ -185,6 +185,25 @@ impl TryFrom<ColliderRecord> for Collider {
     type Error = Error;
 
     fn try_from(r: ColliderRecord) -> Result<Self> {
+        // parry trusts a hull's adjacency; one index past its arrays (a hand-edited file)
+        // panics in its mass properties or contacts later, outside any guard.
+        let hulls = match r.shape.as_compound() {
+            Some(c) => c
+                .shapes()
+                .iter()
+                .filter_map(|(_, s)| s.as_convex_polyhedron())
+                .collect(),
+            None => r
+                .shape
+                .as_convex_polyhedron()
+                .into_iter()
+                .collect::<Vec<_>>(),
+        };
+        if !hulls.iter().all(|h| hull_is_consistent(h)) {
+            return Err(Error::Restored(
+                "a convex hull names a vertex, edge or face it does not have".into(),
+            ));
+        }
         // A malformed composite (a mesh index past its vertices) can panic inside parry.
         let built =
             std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| Collider::new(r.shape)))
@@ -196,6 +215,39 @@ impl TryFrom<ColliderRecord> for Collider {
             ..built
         })
     }
+}
+
+/// Every index of `h`'s adjacency lies inside the array it points into.
+fn hull_is_consistent(h: &parry3d::shape::ConvexPolyhedron) -> bool {
+    let (points, edges, faces) = (h.points().len(), h.edges().len(), h.faces().len());
+    let within = |list: &[u32], len: usize| list.iter().all(|&i| (i as usize) < len);
+    let span = |first: u32, n: u32, len: usize| (first as usize).saturating_add(n as usize) <= len;
+    within(h.vertices_adj_to_face(), points)
+        && within(h.edges_adj_to_face(), edges)
+        && within(h.faces_adj_to_vertex(), faces)
+        && h.vertices().len() == points
+        && h.faces().iter().all(|f| {
+            span(
+                f.first_vertex_or_edge,
+                f.num_vertices_or_edges,
+                h.vertices_adj_to_face().len(),
+            ) && span(
+                f.first_vertex_or_edge,
+                f.num_vertices_or_edges,
+                h.edges_adj_to_face().len(),
+            )
+        })
+        && h.vertices().iter().all(|v| {
+            span(
+                v.first_adj_face_or_edge,
+                v.num_adj_faces_or_edge,
+                h.faces_adj_to_vertex().len(),
+            )
+        })
+        && h.edges().iter().all(|e| {
+            e.vertices.iter().all(|&i| (i as usize) < points)
+                && e.faces.iter().all(|&i| (i as usize) < faces)
+        })
 }
 
 impl std::fmt::Debug for Collider {

@@ -128,3 +128,49 @@ fn a_moving_body_past_the_guard_distance_is_refused() {
     copy.add_physics(PhysicsPlugins);
     assert!(read.restore(&mut copy).is_ok());
 }
+
+/// A convex hull whose face names vertex 4294967295 in a hand-edited snapshot: parry's mass
+/// properties indexed past the vertices inside the restore.
+#[test]
+fn a_hull_naming_a_vertex_it_lacks_is_refused() {
+    let mut w = World::new();
+    w.add_physics(PhysicsPlugins);
+    let points = [
+        Vec3::ZERO,
+        Vec3::X,
+        Vec3::Y,
+        Vec3::Z,
+        Vec3::new(0.7, 0.7, 0.7),
+    ];
+    w.spawn((
+        RigidBody::Dynamic,
+        Collider::convex_hull(&points).unwrap(),
+        Position::from(Vec3::new(0.0, 2.0, 0.0)),
+    ));
+    w.step_physics();
+    let text = Snapshot::capture(&w).unwrap().to_ron().unwrap();
+    // The first face's first vertex index, in the hull's `faces` (or `vertices_adj_to_face`).
+    let mut refused = 0;
+    for key in ["faces_adj_to_vertex", "vertices_adj_to_face", "edges"] {
+        let Some(at) = text.find(key) else { continue };
+        let start = at + text[at..].find(|c: char| c.is_ascii_digit()).unwrap();
+        let end = start + text[start..].find(|c: char| !c.is_ascii_digit()).unwrap();
+        let edited = format!("{}4294967295{}", &text[..start], &text[end..]);
+        let outcome = std::panic::catch_unwind(|| {
+            let read = Snapshot::from_ron(&edited);
+            let mut copy = World::new();
+            copy.add_physics(PhysicsPlugins);
+            let restored = read.map(|s| s.restore(&mut copy).map(|_| ()));
+            if let Ok(Ok(())) = restored {
+                for _ in 0..5 {
+                    copy.step_physics();
+                }
+            }
+            restored.map(|r| r.is_err()).unwrap_or(true)
+        });
+        println!("{key}: {outcome:?}");
+        assert!(outcome.is_ok(), "{key}: a panic");
+        refused += usize::from(matches!(outcome, Ok(true)));
+    }
+    assert!(refused > 0, "some edit reached the hull and was refused");
+}
