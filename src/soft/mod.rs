@@ -22,8 +22,8 @@
 //! |---|---|---|---|---|
 //! | [`StrainModel::Green`] (St. Venant–Kirchhoff) | E = ½ (FᵀF − I) | μ E:E + ½ λ tr(E)² | F (λ tr(E) I + 2 μ E) | moderate stretch with large rotation; it softens and collapses under strong compression |
 //! | [`StrainModel::Cauchy`] (linear) | ε = ½ (F + Fᵀ) − I | μ ε:ε + ½ λ tr(ε)² | λ tr(ε) I + 2 μ ε | small displacements without rotation (the cheapest); a rotation by θ stores the *ghost* energy density 2 (μ + λ)(1 − cos θ)², 1.923 E at 90° and ν = 0.3 — why the lecture moves on to co-rotated strain |
-//! | [`StrainModel::Corotated`] (default) | ε = S − I, F = R S | μ ε:ε + ½ λ tr(ε)² | 2 μ (F − R) + λ tr(ε) R | games: rotation-exact, cheap, robust through inversion (R from an SVD with the inversion kept in S) |
-//! | [`StrainModel::StableNeoHookean`] | — | ½ μ (‖F‖² − 3) − μ (J − 1) + ½ λ′ (J − 1)² | μ F + (λ′ (J − 1) − μ) ∂J/∂F | rubber, flesh, large deformation: nonlinear and volume-preserving, finite and restoring at J ≤ 0 |
+//! | [`StrainModel::Corotated`] (default) | ε = S − I, F = R S | μ ε:ε + ½ λ tr(ε)² | 2 μ (F − R) + λ tr(ε) R | games: rotation-exact, cheap, finite through inversion (R from an SVD with the inversion kept in S); a body *started* inverted was found not to turn back under explicit integration (open) |
+//! | [`StrainModel::StableNeoHookean`] | — | ½ μ (‖F‖² − 3) − μ (J − 1) + ½ λ′ (J − 1)² | μ F + (λ′ (J − 1) − μ) ∂J/∂F | rubber, flesh, large deformation: nonlinear and volume-preserving, finite and restoring at J ≤ 0; a body started crushed to 1 % of its volume was found to stay crushed under implicit integration (open) |
 //!
 //! Stable Neo-Hookean is the form of Smith, de Goes and Kim (2018) as given in Kim and
 //! Eberle's course notes (2020), without the −½ μ log(I_C + 1) term, with λ′ = λ + μ so that
