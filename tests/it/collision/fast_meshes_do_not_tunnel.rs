@@ -73,3 +73,42 @@ fn a_cloth_thrown_at_the_ground_stays_above_it() {
         assert!(low > -0.5, "{speed} m/s: a node reached {low} m");
     }
 }
+
+#[test]
+fn fast_meshes_stay_above_the_ground_at_other_frame_rates_and_substeps() {
+    // What the user did not choose: 30 Hz with 2 substeps (long substeps, the far side
+    // nearer), 144 Hz with 1, and 60 Hz with 8, each under symplectic and implicit Euler.
+    for (hz, substeps) in [(30.0, 2), (144.0, 1), (60.0, 8)] {
+        for integrator in [Integrator::SymplecticEuler, Integrator::ImplicitEuler] {
+            let mut w =
+                scenes::world_with(1.0 / hz, substeps, integrator, Vec3::new(0.0, -9.81, 0.0))
+                    .unwrap();
+            scenes::ground(&mut w).unwrap();
+            let cube = scenes::jelly(&mut w, Vec3::new(-2.0, 2.0, 0.0), true).unwrap();
+            let cloth = ClothBuilder::new(Vec3::new(1.0, 2.0, -1.0), 9, 9, 0.25)
+                .pin_corners(false)
+                .spawn(&mut w)
+                .unwrap();
+            throw(&mut w, cube, Vec3::new(0.0, -300.0, 0.0));
+            throw(&mut w, cloth, Vec3::new(0.0, -200.0, 0.0));
+            let mut low = f32::INFINITY;
+            for _ in 0..hz as usize {
+                w.step_physics();
+                for e in [cube, cloth] {
+                    let n = w.get::<Nodes>(e).unwrap();
+                    low = low.min(
+                        n.positions()
+                            .iter()
+                            .map(|x| x.y)
+                            .fold(f32::INFINITY, f32::min),
+                    );
+                }
+            }
+            println!("{hz} Hz x {substeps}, {integrator:?}: lowest node {low:.3} m");
+            assert!(
+                low > -0.5,
+                "{hz} Hz x {substeps}, {integrator:?}: a node reached {low} m"
+            );
+        }
+    }
+}
