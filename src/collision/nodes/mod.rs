@@ -8,6 +8,12 @@
 //! approaching normal part Δvₙ, and its tangential part is reduced by μ Δvₙ (Coulomb's cone,
 //! μ the collider's [`crate::collision::Friction`]), stopping it when the cone holds.
 //!
+//! **Deep overlaps come out at a bounded speed.** A node is moved out by at most what its
+//! approach brought it in this substep plus [`crate::collision::ContactSettings::max_push_velocity`]
+//! × h, as rigid bodies are: a mesh spawned deep inside a collider (a jelly inside a 236 m
+//! cylinder) walks out whole at that speed instead of every node jumping to its nearest
+//! surface in one substep, which flattened it and threw it out at kilometres per second.
+//!
 //! Against a kinematic collider the same holds relative to its surface's velocity. Under
 //! [`crate::integrator::ImplicitEuler`] each such contact is also a plane the next solve holds the node
 //! to (moving with the surface).
@@ -38,7 +44,7 @@ use glam::{Quat, Vec3, Vec3A};
 use parry3d::math::Pose;
 
 use crate::collision::nodes::coupling::{NodeImpulse, RigidSide, move_soft, soft_response};
-use crate::collision::{Collider, ColliderAabb, ColliderOf, Friction};
+use crate::collision::{Collider, ColliderAabb, ColliderOf, ContactSettings, Friction};
 use crate::core::quarantine::Quarantined;
 use crate::core::time::SubstepTime;
 use crate::integrator::implicit::ContactPlane;
@@ -128,11 +134,18 @@ pub(crate) struct NodeScratch {
 pub(crate) fn collide_nodes<L: NodeLayer>(
     mut commands: Commands,
     time: Res<SubstepTime>,
+    settings: Option<Res<ContactSettings>>,
     mut scratch: Local<NodeScratch>,
     mut bodies: Query<Mesh<L>, Without<Quarantined>>,
     mut colliders: Query<ColliderPose, (Without<Quarantined>, Without<ColliderOf>)>,
 ) {
     let h = time.h;
+    let push = Push {
+        h,
+        max_push: settings.map_or(ContactSettings::default().max_push_velocity, |s| {
+            s.max_push_velocity
+        }),
+    };
     let NodeScratch { meshes, near } = &mut *scratch;
     // Bodies that get their first soft impulse this substep (inserted at its end).
     let mut fresh: Vec<(Entity, NodeImpulse)> = Vec::new();
@@ -200,14 +213,16 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
             if hits.is_empty() {
                 continue;
             }
+            let mut hits = hits;
+            share_the_way_out(&mut hits, n, rigid.as_ref(), push, Vec3::from(x.0));
             match rigid.as_mut() {
                 Some(side) if side.dynamic => {
-                    push_dynamic(n, side, &hits, factor, friction.0, h);
+                    push_dynamic(n, side, &hits, factor, friction.0, push);
                     body.touched_a_body();
                 }
                 other => {
                     let side = other.map(|s| &*s);
-                    push_immovable(n, body.contacts_mut(), side, &hits, friction.0, h);
+                    push_immovable(n, body.contacts_mut(), side, &hits, friction.0, push);
                 }
             }
             // The body takes the impulses at the start of the next substep (see
@@ -247,6 +262,74 @@ struct Hit {
     node: usize,
     normal: Vec3,
     overlap: f32,
+}
+
+/// How far overlaps are closed in one substep.
+#[derive(Clone, Copy)]
+struct Push {
+    /// The substep (s).
+    h: f32,
+    /// The fastest an overlap older than this substep is closed (m/s).
+    max_push: f32,
+}
+
+impl Push {
+    /// The part of `overlap` (m) closed this substep for a node approaching the surface at
+    /// `approach` (m/s, relative to it; negative leaving): all its approach brought in, and
+    /// older overlap at `max_push`. Bounds the speed a mesh spawned deep inside a collider
+    /// comes out at, as the rigid contacts do.
+    #[must_use]
+    fn closed(self, overlap: f32, approach: f32) -> f32 {
+        overlap.min((approach.max(0.0) + self.max_push) * self.h)
+    }
+}
+
+/// Deep hits (more overlap than one substep's push closes) of one mesh in one collider
+/// leave the same way: along the mean of their normals, or, when those cancel (a mesh
+/// centred in a box), from the collider's centre through theirs. Each node's own nearest
+/// surface would tear a mesh that straddles the shape's medial axis apart at the push speed
+/// (a jelly inside a box was pulled to all six faces and went non-finite in three steps).
+/// Shallow hits, every contact of a mesh that did not start inside, keep their own normals.
+fn share_the_way_out(
+    hits: &mut [Hit],
+    n: &Nodes,
+    side: Option<&RigidSide>,
+    push: Push,
+    center: Vec3,
+) {
+    let deep: Vec<bool> = hits
+        .iter()
+        .map(|hit| {
+            let p = Vec3::from(n.x[hit.node]);
+            let base = side.map_or(Vec3::ZERO, |s| s.point_velocity(p));
+            let approach = -(Vec3::from(n.v[hit.node]) - base).dot(hit.normal);
+            push.closed(hit.overlap, approach) < hit.overlap
+        })
+        .collect();
+    let count = deep.iter().filter(|d| **d).count();
+    if count < 2 {
+        return;
+    }
+    let (mut sum, mut centroid, mut first) = (Vec3::ZERO, Vec3::ZERO, None);
+    for (hit, _) in hits.iter().zip(&deep).filter(|(_, d)| **d) {
+        sum += hit.normal;
+        centroid += Vec3::from(n.x[hit.node]);
+        first.get_or_insert(hit.normal);
+    }
+    let way = if sum.length() >= 0.25 * count as f32 {
+        sum.normalize()
+    } else {
+        (centroid / count as f32 - center)
+            .try_normalize()
+            .or(first)
+            .unwrap_or(Vec3::Y)
+    };
+    if !way.is_finite() {
+        return;
+    }
+    for (hit, _) in hits.iter_mut().zip(&deep).filter(|(_, d)| **d) {
+        hit.normal = way;
+    }
 }
 
 /// The bounds of the nodes now and at the substep's start (x − h v).
@@ -327,22 +410,8 @@ fn find_hits(
             });
             continue;
         }
-        let solid = shape.project_local_point(local, true);
-        let (normal_local, depth) = if solid.is_inside {
-            // Inside: the solid projection is the point itself; the surface is the way out.
-            let out = shape.project_local_point(local, false).point - local;
-            let d = out.length();
-            if d == 0.0 {
-                continue;
-            }
-            (out / d, -d)
-        } else {
-            let off = local - solid.point;
-            let d = off.length();
-            if d >= thickness || d == 0.0 {
-                continue;
-            }
-            (off / d, d)
+        let Some((normal_local, depth)) = nearest_surface(&**shape, local, thickness) else {
+            continue;
         };
         hits.push(Hit {
             node: i,
@@ -353,6 +422,49 @@ fn find_hits(
     hits
 }
 
+/// The outward normal at the surface nearest to `local` and its signed distance from it
+/// (m, negative inside), if it is closer than `thickness` or inside.
+///
+/// Inside a convex hull the nearest face plane decides, exactly: parry's projection onto a
+/// hull runs GJK with a tolerance that grows with the shape, and called a point 2.7 cm
+/// below a 720 m hull inside, so a jelly falling out of it had nodes pulled back and
+/// stopped (a 79 m/s jolt).
+fn nearest_surface(
+    shape: &dyn parry3d::shape::Shape,
+    local: Vec3,
+    thickness: f32,
+) -> Option<(Vec3, f32)> {
+    let inside = match shape.as_convex_polyhedron() {
+        Some(hull) => match deepest_face(hull, local) {
+            Some((normal, distance)) if distance <= 0.0 => return Some((normal, distance)),
+            _ => false,
+        },
+        None => shape.project_local_point(local, true).is_inside,
+    };
+    if inside {
+        // Inside: the solid projection is the point itself; the surface is the way out.
+        let out = shape.project_local_point(local, false).point - local;
+        let d = out.length();
+        return (d > 0.0).then(|| (out / d, -d));
+    }
+    let off = local - shape.project_local_point(local, false).point;
+    let d = off.length();
+    (d < thickness && d > 0.0).then(|| (off / d, d))
+}
+
+/// The face of `hull` whose plane `p` is farthest out of (or least deep behind): its outward
+/// normal and that signed distance (m). For a point inside, the nearest surface.
+fn deepest_face(hull: &parry3d::shape::ConvexPolyhedron, p: Vec3) -> Option<(Vec3, f32)> {
+    let (points, corners) = (hull.points(), hull.vertices_adj_to_face());
+    hull.faces()
+        .iter()
+        .filter_map(|face| {
+            let corner = points.get(*corners.get(face.first_vertex_or_edge as usize)? as usize)?;
+            Some((face.normal, face.normal.dot(p - *corner)))
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
 /// A static or kinematic collider: each node is moved out and stops on its own, relative to
 /// the surface's velocity, and leaves a plane for the implicit solve.
 fn push_immovable(
@@ -361,15 +473,23 @@ fn push_immovable(
     side: Option<&RigidSide>,
     hits: &[Hit],
     mu: f32,
-    h: f32,
+    push: Push,
 ) {
     for hit in hits {
         let i = hit.node;
-        n.x[i] += Vec3A::from(hit.normal * hit.overlap);
+        let at = Vec3::from(n.x[i]);
+        let base = side.map_or(Vec3::ZERO, |b| b.point_velocity(at));
+        let approach = -(Vec3::from(n.v[i]) - base).dot(hit.normal);
+        let closed = push.closed(hit.overlap, approach);
+        n.x[i] += Vec3A::from(hit.normal * closed);
         let p = Vec3::from(n.x[i]);
         let base = side.map_or(Vec3::ZERO, |b| b.point_velocity(p));
         let rel = Vec3::from(n.v[i]) - base;
         let vn = rel.dot(hit.normal);
+        // Only the approach bears friction. The push out of older overlap does not: a
+        // deeply embedded mesh whose every node friction stopped each substep would be
+        // stepped as x += h² F / m, stable only to half the explicit limit (a jelly inside
+        // a 236 m cylinder blew up after 3.7 s); it slides along the inside instead.
         if vn < 0.0 {
             let tangent = rel - vn * hit.normal;
             let speed = tangent.length();
@@ -383,7 +503,7 @@ fn push_immovable(
         contacts.push(ContactPlane {
             node: i as u32,
             normal: hit.normal,
-            offset: hit.normal.dot(p) + h * hit.normal.dot(base),
+            offset: hit.normal.dot(p) + push.h * hit.normal.dot(base),
         });
     }
 }
@@ -396,10 +516,11 @@ fn push_dynamic(
     hits: &[Hit],
     factor: Option<&SkylineCholesky>,
     mu: f32,
-    h: f32,
+    push: Push,
 ) {
+    let h = push.h;
     if hits.len() > MAX_COUPLED {
-        push_many(n, side, hits, mu, h);
+        push_many(n, side, hits, mu, push);
         return;
     }
     let rows: Vec<(usize, Vec3)> = hits.iter().map(|h| (h.node, h.normal)).collect();
@@ -408,10 +529,14 @@ fn push_dynamic(
         .map(|h| (Vec3::from(n.x[h.node]), h.normal))
         .collect();
     let g = soft_response(n, factor, &rows, h) + side.response(&at);
-    // G λ ≥ C / h: each overlap closed over the substep.
+    // G λ ≥ C / h: each overlap closed over the substep (deep ones at the push speed).
     let target: Vec<f64> = hits
         .iter()
-        .map(|hit| f64::from(hit.overlap) / f64::from(h))
+        .map(|hit| {
+            let p = Vec3::from(n.x[hit.node]);
+            let approach = -(Vec3::from(n.v[hit.node]) - side.point_velocity(p)).dot(hit.normal);
+            f64::from(push.closed(hit.overlap, approach)) / f64::from(h)
+        })
         .collect();
     let a = hits.len();
     let mut lambda = vec![0.0f64; a];
@@ -458,7 +583,17 @@ fn push_dynamic(
 
 /// Many nodes on one dynamic body: the same impulses node by node, each node with its own
 /// mass (no dense response), several passes so that no node's place in the order favours it.
-fn push_many(n: &mut Nodes, side: &mut RigidSide, hits: &[Hit], mu: f32, h: f32) {
+fn push_many(n: &mut Nodes, side: &mut RigidSide, hits: &[Hit], mu: f32, push: Push) {
+    let h = push.h;
+    // The push-out each overlap may have, fixed by the approach before any impulse.
+    let bias: Vec<f32> = hits
+        .iter()
+        .map(|hit| {
+            let p = Vec3::from(n.x[hit.node]);
+            let approach = -(Vec3::from(n.v[hit.node]) - side.point_velocity(p)).dot(hit.normal);
+            push.closed(hit.overlap, approach) / h
+        })
+        .collect();
     let mut normal_impulse = vec![0.0f32; hits.len()];
     let mut friction_impulse = vec![Vec3::ZERO; hits.len()];
     for _ in 0..CONTACT_PASSES.min(8) {
@@ -468,9 +603,8 @@ fn push_many(n: &mut Nodes, side: &mut RigidSide, hits: &[Hit], mu: f32, h: f32)
             let p = Vec3::from(n.x[i]);
             let rel = Vec3::from(n.v[i]) - side.point_velocity(p);
             let vn = rel.dot(hit.normal);
-            let bias = hit.overlap / h;
             let total = (normal_impulse[k]
-                + (bias - vn) / (inv_node + side.inverse_mass_along(p, hit.normal)))
+                + (bias[k] - vn) / (inv_node + side.inverse_mass_along(p, hit.normal)))
             .max(0.0);
             let mut j = (total - normal_impulse[k]) * hit.normal;
             normal_impulse[k] = total;

@@ -12,6 +12,7 @@ mod fast_meshes_do_not_tunnel;
 mod fast_spin_stays_above_ground;
 mod landing_stays_in_place;
 mod mesh_contacts;
+mod meshes_leave_deep_overlap_at_a_bounded_speed;
 mod no_tunnelling;
 mod node_contacts_never_panic;
 mod recycling;
