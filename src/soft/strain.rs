@@ -74,8 +74,10 @@ fn polar_f64(f: DMat3) -> (DMat3, DMat3) {
             }
         }
     }
-    let svd = glamx::DSvd3::from_matrix(f);
-    let (mut u, mut sigma, mut v) = (svd.u, svd.s, svd.vt.transpose());
+    let Some((mut u, mut sigma, mut v)) = svd(f) else {
+        // Not reached for finite F; a non-finite F is its body's quarantine.
+        return (DMat3::IDENTITY, symmetric(f));
+    };
     // Make U and V proper rotations; each flip keeps F = U Σ Vᵀ by moving the sign into the
     // smallest singular value (they come sorted descending), which ends with the sign of
     // det F.
@@ -90,6 +92,27 @@ fn polar_f64(f: DMat3) -> (DMat3, DMat3) {
     let r = u * v.transpose();
     let s = v * DMat3::from_diagonal(sigma) * v.transpose();
     (r, symmetric(s))
+}
+
+/// F = U Σ Vᵀ with the singular values sorted descending, by nalgebra's SVD, which holds on
+/// rank-deficient F: `glamx::DSvd3` goes through the eigenvectors of FᵀF and gave a NaN U
+/// for an element collapsed onto a line (a jelly thrown at the ground at 150 m/s went
+/// non-finite) and a U that was not orthogonal for another of rank 1.
+fn svd(f: DMat3) -> Option<(DMat3, glam::DVec3, DMat3)> {
+    let m = nalgebra::Matrix3::from_column_slice(&f.to_cols_array());
+    let svd = m.svd(true, true);
+    let (u, vt) = (svd.u?, svd.v_t?);
+    let (u, v) = (
+        DMat3::from_cols_slice(u.as_slice()),
+        DMat3::from_cols_slice(vt.transpose().as_slice()),
+    );
+    let s = svd.singular_values;
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| s[b].total_cmp(&s[a]));
+    let pick = |m: DMat3| DMat3::from_cols(m.col(order[0]), m.col(order[1]), m.col(order[2]));
+    let sigma = glam::DVec3::new(s[order[0]], s[order[1]], s[order[2]]);
+    let (u, v) = (pick(u), pick(v));
+    (u.is_finite() && v.is_finite() && sigma.is_finite()).then_some((u, sigma, v))
 }
 
 fn frobenius2(m: DMat3) -> f64 {

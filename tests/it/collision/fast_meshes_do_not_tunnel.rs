@@ -37,7 +37,7 @@ fn lowest(w: &mut World, e: Entity, seconds: f32) -> (f32, bool) {
 #[test]
 fn a_soft_cube_thrown_at_the_ground_stays_above_it() {
     for implicit in [true, false] {
-        for speed in [50.0, 300.0] {
+        for speed in [50.0, 150.0, 300.0] {
             let mut w = World::new();
             w.add_physics(PhysicsPlugins);
             scenes::ground(&mut w).unwrap();
@@ -51,6 +51,12 @@ fn a_soft_cube_thrown_at_the_ground_stays_above_it() {
             assert!(
                 low > -0.5,
                 "implicit {implicit}, {speed} m/s: a node reached {low} m"
+            );
+            // The impact crushes some elements onto a line; their strain stays finite, so
+            // the cube is not removed (it went non-finite from 150 m/s under explicit).
+            assert!(
+                !quarantined,
+                "implicit {implicit}, {speed} m/s: quarantined"
             );
         }
     }

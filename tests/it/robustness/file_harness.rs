@@ -225,7 +225,7 @@ pub fn fuzz_snapshots(cases: u32, seed: u64, which: Cases) -> Tally {
     let cell = std::cell::RefCell::new((&mut tally, Tally::default(), false));
     let result = runner.run(&(harness::world_case(), edit()), |(case, edit)| {
         let (tally, scratch, failed) = &mut *cell.borrow_mut();
-        if !*failed && !which.borrow_mut().take() {
+        if !*failed && !which.borrow_mut().take(tally) {
             return Ok(());
         }
         let t: &mut Tally = if *failed { scratch } else { tally };
@@ -307,7 +307,7 @@ pub fn fuzz_scenarios(cases: u32, seed: u64, which: Cases) -> Tally {
     let cell = std::cell::RefCell::new((&mut tally, Tally::default(), false));
     let result = runner.run(&(any::<u32>(), edit()), |(pick, edit)| {
         let (tally, scratch, failed) = &mut *cell.borrow_mut();
-        if !*failed && !which.borrow_mut().take() {
+        if !*failed && !which.borrow_mut().take(tally) {
             return Ok(());
         }
         let t: &mut Tally = if *failed { scratch } else { tally };

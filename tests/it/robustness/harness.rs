@@ -509,8 +509,10 @@ impl Cases {
         }
     }
 
-    /// Whether to run the next generated case (not a shrinking rerun).
-    pub fn take(&mut self) -> bool {
+    /// Whether to run the next generated case (not a shrinking rerun). Announced, it prints
+    /// the tally of the cases `done` so far first, which the supervisor keeps if the child
+    /// dies in this case.
+    pub fn take(&mut self, done: &Tally) -> bool {
         let k = self.next;
         self.next += 1;
         if k < self.skip {
@@ -518,6 +520,10 @@ impl Cases {
         }
         if self.announce {
             use std::io::Write;
+            println!(
+                "done{}",
+                &super::supervisor::tally_line(done)["tally".len()..]
+            );
             println!("case {k}");
             let _ = std::io::stdout().flush();
         }
@@ -546,7 +552,7 @@ pub fn fuzz_worlds_of(cases: u32, seed: u64, check_snapshot: bool, which: Cases)
         }
         let start = std::time::Instant::now();
         let (tally, scratch, failed) = &mut *cell.borrow_mut();
-        if !*failed && !which.borrow_mut().take() {
+        if !*failed && !which.borrow_mut().take(tally) {
             return Ok(());
         }
         // Shrinking reruns failing cases: they go to a scratch tally (see fuzz_constructors).

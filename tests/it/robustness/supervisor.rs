@@ -1,9 +1,10 @@
 //! Fuzzing in a child process, so that what cannot be caught in-process is counted too: an
 //! abort (stack overflow, allocation failure) ends the child, a hang stops its output. The
-//! child prints `case K` before each case and `tally …` at the end; the parent reads its
+//! child prints `done …` (its tally so far) and `case K` before each case and `tally …` at
+//! the end; the parent reads its
 //! output with a watchdog, counts an abort when the child dies mid-run and a hang when a
 //! case prints nothing for longer than the watchdog (it kills the child), and starts a new
-//! child after the case that failed. Shared by `robustness::fuzz` and `examples/fuzz.rs`.
+//! child after the case that failed, keeping the dead child's last `done` tally. Shared by `robustness::fuzz` and `examples/fuzz.rs`.
 #![allow(dead_code)]
 
 use std::io::{BufRead, BufReader};
@@ -62,6 +63,8 @@ pub fn supervise(child: impl Fn(u32) -> Command, total: u32, watchdog: Duration)
         });
         let mut current = skip;
         let mut finished = false;
+        // What the child had done before the case it is in; counted if it dies there.
+        let mut done = Tally::default();
         loop {
             match lines.recv_timeout(watchdog) {
                 Ok(line) => {
@@ -70,6 +73,9 @@ pub fn supervise(child: impl Fn(u32) -> Command, total: u32, watchdog: Duration)
                         .and_then(|k| k.trim().parse().ok())
                     {
                         current = k;
+                    } else if let Some(t) = line.strip_prefix("done ") {
+                        done = Tally::default();
+                        add(&mut done, t);
                     } else if let Some(t) = line.strip_prefix("tally ") {
                         add(&mut out.tally, t);
                         finished = true;
@@ -80,11 +86,13 @@ pub fn supervise(child: impl Fn(u32) -> Command, total: u32, watchdog: Duration)
                 Err(mpsc::RecvTimeoutError::Timeout) => {
                     let _ = process.kill();
                     out.hangs.push(current);
+                    add_tally(&mut out.tally, &done);
                     break;
                 }
                 Err(mpsc::RecvTimeoutError::Disconnected) => {
                     if !finished {
                         out.aborts.push(current);
+                        add_tally(&mut out.tally, &done);
                     }
                     break;
                 }
@@ -136,4 +144,8 @@ fn add(t: &mut Tally, line: &str) {
         t.steps += steps;
         t.snapshot_mismatches += mismatches;
     }
+}
+
+fn add_tally(t: &mut Tally, more: &Tally) {
+    add(t, &tally_line(more)["tally ".len()..]);
 }

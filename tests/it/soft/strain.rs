@@ -223,6 +223,44 @@ fn polar_decomposition_is_a_rotation_times_a_symmetric_stretch_even_inverted() {
     }
 }
 
+/// Regression (issue 37): an element collapsed onto a point, a line or a plane (a jelly
+/// thrown at the ground at 150 m/s crushes some) still has a rotation and a symmetric S
+/// with F = R S. The SVD it used went through the eigenvectors of FᵀF and gave a NaN R for
+/// F of rank 1, so the body went non-finite and was quarantined.
+#[test]
+fn polar_decomposition_holds_on_collapsed_elements() {
+    let a = Vec3::new(0.3, 0.2, 0.1);
+    let b = Vec3::new(-0.4, 0.9, 0.2);
+    let collapsed = [
+        Mat3::ZERO,
+        Mat3::from_cols(Vec3::X, Vec3::ZERO, Vec3::ZERO),
+        Mat3::from_cols(Vec3::X, Vec3::X, Vec3::ZERO),
+        Mat3::from_cols(a, 2.0 * a, -a),
+        Mat3::from_cols(a, b, a + b),
+        Mat3::from_cols(Vec3::X, Vec3::Y, Vec3::ZERO),
+        Mat3::from_cols(Vec3::X, Vec3::X * (1.0 + 1e-7), Vec3::Y),
+    ];
+    for f in collapsed {
+        let (r, s) = polar_decomposition(f);
+        assert!(r.is_finite() && s.is_finite(), "{f}: R {r}, S {s}");
+        assert!(
+            (r.transpose() * r).abs_diff_eq(Mat3::IDENTITY, 1e-5),
+            "{f}: R {r}"
+        );
+        assert!(
+            (r.determinant() - 1.0).abs() < 1e-5,
+            "{f}: det R {}",
+            r.determinant()
+        );
+        assert!(s.abs_diff_eq(s.transpose(), 1e-5), "{f}: S {s}");
+        assert!((r * s).abs_diff_eq(f, 1e-5), "{f}: R S = {}", r * s);
+        let lame = unit(0.3);
+        for model in [StrainModel::Corotated, StrainModel::StableNeoHookean] {
+            assert!(model.first_piola(f, lame).is_finite(), "{model:?} at {f}");
+        }
+    }
+}
+
 /// F = R₀ S with S symmetric positive definite has the polar factor R₀, whichever path
 /// computes it: a mild stretch takes the fast (Newton) path, a very anisotropic one the SVD.
 #[test]
