@@ -3,6 +3,7 @@
 mod bad_input;
 mod bad_input_caught;
 mod bounded_clock;
+mod closed_worlds_never_gain_energy;
 mod file_counts_never_overflow;
 mod file_harness;
 mod fuzz;

@@ -1,5 +1,6 @@
 //! Springs, chains and spring meshes: forces, stability limits, warnings and the implicit solves.
 
+mod a_stiff_rope_is_rescued_whole;
 mod chain;
 mod dampers_are_not_runaways;
 mod damping_limit;
