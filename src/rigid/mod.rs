@@ -356,11 +356,13 @@ fn unit(q: Quat) -> Quat {
     serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
 pub enum OrientationUpdate {
-    /// Free-rotation splitting (the default): the kinetic energy Σ Lᵢ²/2Iᵢ is split into
-    /// three spins about the principal axes, each solved exactly (L fixed in the world, the
-    /// body turning about axis i at Lᵢ/Iᵢ). Lie–Trotter order for the Euler integrators,
-    /// Strang order for Verlet. It is symplectic: |L| is exact and the energy error stays
-    /// bounded, with no drift. Costs three (five for Verlet) axis rotations.
+    /// Free-rotation splitting (the default): the kinetic energy Σ Lᵢ²/2Iᵢ is split about
+    /// the middle moment I₂ into a turn about the fixed world L at |L|/I₂ and two spins
+    /// about the other principal axes at Lᵢ (1/Iᵢ − 1/I₂), each solved exactly (see
+    /// [`free_rotation_split`]). Lie–Trotter order for the Euler integrators, Strang order
+    /// for Verlet. It is symplectic: |L| is exact and the energy error stays bounded, with
+    /// no drift; a body with two equal moments (a rod, a disc) turns exactly. Costs three
+    /// (five for Verlet) axis rotations.
     #[default]
     Splitting,
     /// q ← exp(½ h ω) ⊗ q with ω = I(q)⁻¹L held over the step: exact for constant ω and keeps
@@ -527,9 +529,16 @@ pub fn integrate_rotation(q: Quat, omega: Vec3A, h: f32, update: OrientationUpda
 }
 
 /// The free-rotation splitting step for a body with world angular momentum `l` held over
-/// `h`: exact spins about the principal axes in the order 1, 2, 3 (`strang == false`, first
-/// order) or ½1, ½2, 3, ½2, ½1 (`strang == true`, second order). With three equal moments
-/// ω = L/I is constant and the step is the exact turn exp(½ h ω) ⊗ q instead.
+/// `h`. The energy ½ Σ Lᵢ²/Iᵢ is split about the middle moment I₂ as ½ |L|²/I₂ (a turn
+/// about the fixed world L at |L|/I₂, which commutes with every other flow since |L| is
+/// kept by all of them) plus ½ Lᵢ² (1/Iᵢ − 1/I₂) for the other two axes (spins about
+/// them), each solved exactly, in the order 1, 3, L (`strang == false`, first order) or
+/// ½1, ½3, L, ½3, ½1 (`strang == true`, second order). A body with two equal moments (a
+/// rod, a disc, a square plate) then turns exactly: one spin and the turn about L commute.
+/// Splitting about the principal axes alone (1, 2, 3) let a rod spinning at 45 rad/s
+/// drift 9.5e-4 in energy over 10 s at 60 Hz (7.5e-6 now, rounding) and precess 0.4 rad/s
+/// off the closed form: the spins about the two equal axes do not commute with the fast
+/// one. With three equal moments ω = L/I is constant and the step is one exact turn.
 #[must_use]
 #[inline]
 pub fn free_rotation_split(q: Quat, inertia: &Inertia, l: Vec3A, h: f32, strang: bool) -> Quat {
@@ -539,17 +548,28 @@ pub fn free_rotation_split(q: Quat, inertia: &Inertia, l: Vec3A, h: f32, strang:
         // turn by h ω, which both splittings only approximate.
         return turn_by(l * (inv.x * h)) * unit(q);
     }
-    // p maps the principal frame to the world; each sub-flow turns it about one of its own
-    // axes (right multiplication) at the rate L_body,i / I_i, which leaves world L fixed.
+    // p maps the principal frame to the world; each spin turns it about one of its own
+    // axes (right multiplication) at the rate L_body,i (1/Iᵢ − 1/I₂), which leaves world L
+    // fixed; the turn about L multiplies it on the left and leaves the body-frame L alone.
     let mut p = unit(q) * inertia.frame;
+    let inv = inv.to_array();
+    // The middle moment: of two equal ones, one of them.
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| inv[a].total_cmp(&inv[b]));
+    let (first, mid, last) = (order[0], order[1], order[2]);
+    let reference = inv[mid];
+    let (first, last) = (first.min(last), first.max(last));
 
     // L in the principal frame, carried along: turning the body by θ about axis i turns
     // its body-frame L by −θ about the same axis, which only mixes the other two
-    // components. One full rotation instead of one per spin keeps the dependency chain short.
+    // components.
     let mut lb = (p.inverse() * l).to_array();
-    let inv = inertia.inverse.to_array();
-    let mut spin = |axis: usize, dt: f32| {
-        let (s, c) = small_sin_cos(0.5 * dt * lb[axis] * inv[axis]);
+    let mut spin = |p: &mut Quat, axis: usize, dt: f32| {
+        let rate = inv[axis] - reference;
+        if rate == 0.0 {
+            return;
+        }
+        let (s, c) = small_sin_cos(0.5 * dt * lb[axis] * rate);
         let (j, k) = ((axis + 1) % 3, (axis + 2) % 3);
         let (sin, cos) = (2.0 * s * c, 1.0 - 2.0 * s * s);
         let (a, b) = (lb[j], lb[k]);
@@ -557,20 +577,20 @@ pub fn free_rotation_split(q: Quat, inertia: &Inertia, l: Vec3A, h: f32, strang:
         lb[k] = cos * b - sin * a;
         let mut r = [0.0, 0.0, 0.0, c];
         r[axis] = s;
-        p *= Quat::from_array(r);
+        *p *= Quat::from_array(r);
     };
 
     if strang {
         let half = 0.5 * h;
-        spin(0, half);
-        spin(1, half);
-        spin(2, h);
-        spin(1, half);
-        spin(0, half);
+        spin(&mut p, first, half);
+        spin(&mut p, last, half);
+        p = turn_by(l * (reference * h)) * p;
+        spin(&mut p, last, half);
+        spin(&mut p, first, half);
     } else {
-        spin(0, h);
-        spin(1, h);
-        spin(2, h);
+        spin(&mut p, first, h);
+        spin(&mut p, last, h);
+        p = turn_by(l * (reference * h)) * p;
     }
     p * inertia.frame.inverse()
 }

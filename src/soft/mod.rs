@@ -22,12 +22,15 @@
 //! |---|---|---|---|---|
 //! | [`StrainModel::Green`] (St. Venant–Kirchhoff) | E = ½ (FᵀF − I) | μ E:E + ½ λ tr(E)² | F (λ tr(E) I + 2 μ E) | moderate stretch with large rotation; it softens and collapses under strong compression |
 //! | [`StrainModel::Cauchy`] (linear) | ε = ½ (F + Fᵀ) − I | μ ε:ε + ½ λ tr(ε)² | λ tr(ε) I + 2 μ ε | small displacements without rotation (the cheapest); a rotation by θ stores the *ghost* energy density 2 (μ + λ)(1 − cos θ)², 1.923 E at 90° and ν = 0.3 — why the lecture moves on to co-rotated strain |
-//! | [`StrainModel::Corotated`] (default) | ε = S − I, F = R S | μ ε:ε + ½ λ tr(ε)² | 2 μ (F − R) + λ tr(ε) R | games: rotation-exact, cheap, finite through inversion (R from an SVD with the inversion kept in S); a body *started* inverted turns back under implicit integration; under explicit integration without damping the released energy keeps it ringing through inversion (a mirrored jelly keeps about half its elements inverted) |
-//! | [`StrainModel::StableNeoHookean`] | — | ½ μ (‖F‖² − 3) − μ (J − 1) + ½ λ′ (J − 1)² | μ F + (λ′ (J − 1) − μ) ∂J/∂F | rubber, flesh, large deformation: nonlinear and volume-preserving, finite and restoring at J ≤ 0; F = 0 is a local minimum of this Ψ (P(0) = 0, Hessian μ I), so an element crushed uniformly below J ≈ 0.024 (ν = 0.3) collapses to a point and stays there: a body started at 1 % of its volume stays crushed (open) |
+//! | [`StrainModel::Corotated`] (default) | ε = S − I, F = R S | μ ε:ε + ½ λ tr(ε)² | 2 μ (F − R) + λ tr(ε) R | games: rotation-exact, cheap, finite through inversion (R from an SVD with the inversion kept in S); a body started inverted or crushed turns back (explicit steps alone, without damping, would keep the energy an inversion stores ringing through inversion: at the defaults a body with inverted elements is solved by BDF2) |
+//! | [`StrainModel::StableNeoHookean`] | — | ½ μ′ (I_C − 3) + ½ λ′ (J − α)² − ½ μ′ log(I_C + 1) − Ψ₀, I_C = ‖F‖² | μ′ (1 − 1/(I_C + 1)) F + λ′ (J − α) ∂J/∂F | rubber, flesh, large deformation: nonlinear and volume-preserving, finite and restoring at J ≤ 0; a body started inverted or crushed to 1 % of its volume turns back (the log term makes F = 0 a saddle, not a minimum) |
 //!
-//! Stable Neo-Hookean is the form of Smith, de Goes and Kim (2018) as given in Kim and
-//! Eberle's course notes (2020), without the −½ μ log(I_C + 1) term, with λ′ = λ + μ so that
-//! small strains match linear elasticity. Units: Pa for E, μ, λ, P; J/m³ for Ψ.
+//! Stable Neo-Hookean is the energy of Smith, de Goes and Kim (2018, eq. 14–16) with its log
+//! term: μ′ = 4/3 μ and λ′ = λ + 5/6 μ so that small strains match linear elasticity,
+//! α = 1 + 3 μ′ / (4 λ′) so that F = I is stress-free, and Ψ₀ = ½ λ′ (1 − α)² − ½ μ′ log 4 so
+//! that its energy is zero there. Without the log term F = 0 is a local minimum (Hessian
+//! μ I) and an element crushed below J ≈ 0.024 stays a point. Units: Pa for E, μ, λ, P; J/m³
+//! for Ψ.
 
 mod attach;
 mod implicit;

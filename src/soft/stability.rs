@@ -30,6 +30,7 @@ use crate::integrator::stability::{
     put_rescue,
 };
 use crate::integrator::{ImplicitEuler, ImplicitScheme, Integrator, IntegratorOverride, Rescue};
+use crate::particles::Nodes;
 
 /// Local substeps per substep at most that [`StabilityPolicy::Automatic`] takes for a soft
 /// body before it solves it by BDF2 instead: the count at which they cost about what BDF2's
@@ -78,6 +79,7 @@ pub(crate) fn check_soft_stability(
         (
             Entity,
             Ref<SoftBody>,
+            &Nodes,
             &mut SoftStability,
             Has<ImplicitEuler>,
             Option<&IntegratorOverride>,
@@ -91,7 +93,7 @@ pub(crate) fn check_soft_stability(
     let policy = policy.map_or_else(StabilityPolicy::default, |p| *p);
     let substep = time.dt() / time.substeps() as f32;
     let mut smallest = f32::INFINITY;
-    for (e, body, mut stability, implicit, o, local) in &mut bodies {
+    for (e, body, nodes, mut stability, implicit, o, local) in &mut bodies {
         let fresh = !stability.computed || body.is_changed();
         if fresh {
             stability.critical_step = body.critical_step();
@@ -100,6 +102,17 @@ pub(crate) fn check_soft_stability(
         smallest = smallest.min(stability.critical_step);
         let method = o.map_or(*global, |o| o.0);
         if implicit || method == Integrator::ImplicitEuler {
+            continue;
+        }
+        // A body with inverted elements is far from the rest state its limit was judged at
+        // (stable Neo-Hookean stiffens with the cofactor of F, past any substep count taken
+        // at rest), and explicit steps without damping keep the energy an inversion stores
+        // ringing through inversion for ever (a jelly started mirrored stayed half inside
+        // out): BDF2 brings it back.
+        if body.stats.inverted > 0 || (fresh && has_inverted_elements(&body, nodes)) {
+            if policy.rescue(method).is_some() {
+                put_rescue(&mut commands, e, Rescue::Implicit(ImplicitScheme::Bdf2));
+            }
             continue;
         }
         // Rescued by local substeps, it is solved by BDF2 once it presses on a dynamic body
@@ -133,4 +146,14 @@ pub(crate) fn check_soft_stability(
     if let Some(d) = diag.as_mut() {
         d.soft_critical_step = smallest;
     }
+}
+
+/// True if an element of `body` is inverted (det F ≤ 0) at `nodes`; elements naming a node
+/// past them are left to the step's own check.
+fn has_inverted_elements(body: &SoftBody, nodes: &Nodes) -> bool {
+    let x = nodes.positions();
+    (0..body.tets.len()).any(|k| {
+        body.tets[k].iter().all(|&i| (i as usize) < x.len())
+            && body.deformation_gradient(x, k).determinant() <= 0.0
+    })
 }

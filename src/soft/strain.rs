@@ -256,14 +256,15 @@ impl StrainModel {
                 }
             }
             StrainModel::StableNeoHookean => {
-                // λ + μ so that small strains meet linear elasticity (see the module docs).
-                let l = lambda + mu;
+                let p = NeoHookeanParameters::new(lame);
                 let j = f.determinant();
                 let c = cofactor(f);
+                let i_c = ddot(f, f);
                 Stress {
-                    energy: 0.5 * mu * (ddot(f, f) - 3.0) - mu * (j - 1.0)
-                        + 0.5 * l * (j - 1.0).powi(2),
-                    piola: mu * f + (l * (j - 1.0) - mu) * c,
+                    energy: 0.5 * p.mu * (i_c - 3.0) + 0.5 * p.lambda * (j - p.alpha).powi(2)
+                        - 0.5 * p.mu * (i_c + 1.0).ln()
+                        - p.rest,
+                    piola: p.mu * (1.0 - 1.0 / (i_c + 1.0)) * f + p.lambda * (j - p.alpha) * c,
                 }
             }
         }
@@ -294,6 +295,36 @@ impl StrainModel {
     #[must_use]
     pub fn differentials(self, f: Mat3, lame: Lame) -> [Mat3; 9] {
         Prepared::new(self, f, lame).differentials(lame)
+    }
+}
+
+/// The parameters of stable Neo-Hookean's energy
+/// Ψ = ½ μ′ (I_C − 3) + ½ λ′ (J − α)² − ½ μ′ log(I_C + 1) − Ψ₀ from the Lamé parameters:
+/// μ′ = 4/3 μ and λ′ = λ + 5/6 μ make its small strains those of linear elasticity,
+/// α = 1 + 3 μ′ / (4 λ′) makes F = I stress-free, and Ψ₀ = ½ λ′ (1 − α)² − ½ μ′ log 4 its
+/// energy zero (Smith, de Goes and Kim 2018, eq. 14–16). The log term is what makes F = 0
+/// no minimum: without it the Hessian there is μ I, and an element crushed below
+/// J ≈ 0.024 collapsed to a point and stayed there.
+#[derive(Debug, Clone, Copy)]
+struct NeoHookeanParameters {
+    mu: f32,
+    lambda: f32,
+    alpha: f32,
+    rest: f32,
+}
+
+impl NeoHookeanParameters {
+    fn new(lame: Lame) -> Self {
+        let mu = 4.0 / 3.0 * lame.mu;
+        let lambda = lame.lambda + 5.0 / 6.0 * lame.mu;
+        let alpha = 1.0 + 0.75 * mu / lambda;
+        let rest = 0.5 * lambda * (1.0 - alpha).powi(2) - 0.5 * mu * 4f32.ln();
+        Self {
+            mu,
+            lambda,
+            alpha,
+            rest,
+        }
     }
 }
 
@@ -400,8 +431,12 @@ impl Prepared {
                     + (lambda * e - 2.0 * mu) * dr
             }
             Prepared::StableNeoHookean { f, j, cofactor: c } => {
-                let l = lambda + mu;
-                mu * df + l * ddot(c, df) * c + (l * (j - 1.0) - mu) * cofactor_differential(f, df)
+                let p = NeoHookeanParameters::new(lame);
+                let k = 1.0 / (ddot(f, f) + 1.0);
+                p.mu * (1.0 - k) * df
+                    + (2.0 * p.mu * k * k * ddot(f, df)) * f
+                    + p.lambda * ddot(c, df) * c
+                    + p.lambda * (j - p.alpha) * cofactor_differential(f, df)
             }
         }
     }

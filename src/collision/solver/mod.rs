@@ -27,6 +27,7 @@ mod colour;
 pub(crate) mod exchange;
 pub(crate) mod plugin;
 pub(crate) mod prepare;
+mod turning;
 pub(crate) mod whole_step;
 
 use bevy_ecs::prelude::*;
@@ -46,10 +47,17 @@ pub(crate) struct SolverBody {
     pub entity: Entity,
     /// Zero for kinematic bodies: they drive contacts but are never pushed.
     pub inv_mass: f32,
-    /// World inverse inertia at the start of the step (zero for kinematic bodies).
+    /// World inverse inertia the contact axes were last formed with (zero for kinematic
+    /// bodies): at the start of the step, then at the rotation `q_axes`.
     pub inv_i: Mat3A,
-    /// World inertia at the start of the step (zero for kinematic bodies and particles).
+    /// World inertia matching `inv_i` (zero for kinematic bodies and particles): an impulse
+    /// pass's change of ω times it is the angular impulse it gave.
     pub i0: Mat3A,
+    /// World inverse inertia and inertia at the start of the step.
+    pub inv_i_start: Mat3A,
+    pub i_start: Mat3A,
+    /// The rotation at which `inv_i` was formed.
+    pub q_axes: Quat,
     /// Centre of mass and rotation at the start of the step.
     pub x0: Vec3A,
     pub q0: Quat,
@@ -80,6 +88,9 @@ impl SolverBody {
             inv_mass,
             inv_i,
             i0: inv_i,
+            inv_i_start: inv_i,
+            i_start: inv_i,
+            q_axes: Quat::IDENTITY,
             x0: Vec3A::ZERO,
             q0: Quat::IDENTITY,
             q_seen: Quat::IDENTITY,
@@ -298,6 +309,10 @@ pub(crate) struct ContactSolver {
     /// Colouring scratch, kept to reuse its memory.
     colours: Vec<Vec<u32>>,
     used: Vec<u64>,
+    /// Bodies whose inertia a gather turned (see [`Self::after_gather`]), and a per-body
+    /// mark for the batch scan.
+    pub turned: Vec<u32>,
+    turned_mark: Vec<bool>,
 }
 
 /// Solver index per entity.
@@ -468,6 +483,7 @@ impl ContactSolver {
         self.points.clear();
         self.tracks.clear();
         self.friction.clear();
+        self.turned.clear();
     }
 
     /// Index of the rest state (static sides, empty lanes).
@@ -514,13 +530,6 @@ impl ContactSolver {
         self.friction[bi].compute(&batch, (ma, &ia), (mb, &ib), lanes);
         let batch = &mut self.batches[bi];
         (batch.inv_m_a, batch.inv_m_b) = (ma, mb);
-    }
-
-    /// [`Self::freeze`] for each of `bodies` (those a gather found non-finite).
-    pub fn freeze_all(&mut self, bodies: &[u32]) {
-        for &body in bodies {
-            self.freeze(body);
-        }
     }
 
     /// Takes `body` out of the rest of the step: it turned non-finite, and from now on every

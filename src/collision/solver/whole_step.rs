@@ -358,7 +358,7 @@ fn step(
                     read_body(&mut solver, j, b, &mut s.frozen);
                 }
             }
-            solver.freeze_all(&s.frozen);
+            solver.after_gather(&s.frozen);
             biased_pass(&mut solver, &t, &settings);
             s.frozen.clear();
             for (j, b) in in_solver.iter_mut().enumerate() {
@@ -368,7 +368,7 @@ fn step(
                     read_body(&mut solver, j, b, &mut s.frozen);
                 }
             }
-            solver.freeze_all(&s.frozen);
+            solver.after_gather(&s.frozen);
             relax_pass(&mut solver, &mut contacts, &t, &settings);
             for (j, b) in in_solver.iter_mut().enumerate() {
                 if b.live {

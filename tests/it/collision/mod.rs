@@ -19,4 +19,5 @@ mod recycling;
 mod restitution_energy;
 mod restitution_threshold;
 mod spatial_query;
+mod spinning_rods_land_without_gaining_energy;
 mod tall_stacks;

@@ -7,8 +7,10 @@
 //! jellies, each in its own cell so that nothing starts overlapping (an overlap is stored
 //! energy the push-out releases), at random speeds, restitution and friction, with gravity
 //! and every damping off, under each integrator that keeps energy bounded (symplectic Euler,
-//! velocity Verlet, RK4 and implicit Euler; forward Euler gains energy by design), at random
-//! substeps. The total energy `PhysicsDiagnostics::total_energy` (kinetic, rotational,
+//! velocity Verlet, RK4 and implicit Euler; forward Euler gains energy by design), at 4 to 8
+//! substeps and spins up to 104 rad/s (at most 0.43 rad a substep: faster, the bounded
+//! energy error of the free-rotation splitting on a body with three unequal moments is no
+//! longer small). The total energy `PhysicsDiagnostics::total_energy` (kinetic, rotational,
 //! spring and elastic) must never pass the start by more than the scheme's own wobble: a
 //! symplectic scheme's measured energy oscillates about the conserved one by O(h ω), which
 //! the local substeps of the default stability policy keep below a few percent.
@@ -59,14 +61,19 @@ fn vec(r: f32) -> impl Strategy<Value = Vec3> {
 
 fn thing() -> impl Strategy<Value = Thing> {
     prop_oneof![
-        (0.1f32..0.6, vec(8.0)).prop_map(|(r, v)| Thing::Ball(r, v)),
+        (0.1f32..0.6, vec(20.0)).prop_map(|(r, v)| Thing::Ball(r, v)),
         (
-            vec(0.5).prop_map(|h| h.abs() + Vec3::splat(0.1)),
-            vec(8.0),
-            vec(10.0)
+            vec(0.5).prop_map(|h| h.abs() + Vec3::splat(0.05)),
+            vec(20.0),
+            prop_oneof![vec(10.0), vec(60.0)]
         )
             .prop_map(|(h, v, w)| Thing::Crate(h, v, w)),
-        (2usize..10, 10.0f32..1e4, vec(1.0), vec(3.0))
+        (
+            2usize..10,
+            prop_oneof![10.0f32..1e4, 1e6f32..1e9],
+            vec(1.0),
+            vec(3.0)
+        )
             .prop_map(|(n, k, d, v)| Thing::Rope(n, k, d, v)),
         (3usize..6, 0.1f32..0.3, vec(3.0)).prop_map(|(n, s, v)| Thing::Cloth(n, s, v)),
         (1e4f32..1e6, any::<bool>(), vec(5.0)).prop_map(|(e, i, v)| Thing::Jelly(e, i, v)),
@@ -81,7 +88,7 @@ fn closed() -> impl Strategy<Value = Closed> {
             Just(Integrator::Rk4),
             Just(Integrator::ImplicitEuler),
         ],
-        prop_oneof![Just(4u32), 1u32..9],
+        prop_oneof![Just(4u32), 4u32..9],
         0.0f32..1.0,
         0.0f32..1.0,
         prop::collection::vec(thing(), 1..8),

@@ -2,6 +2,7 @@
 
 mod attach;
 mod contact_two_way;
+mod crushed_starts_recover;
 mod implicit;
 mod mesh_files;
 mod meshes_changed_mid_run;

@@ -293,7 +293,11 @@ fn polar_decomposition_returns_the_known_rotation_on_both_of_its_paths() {
 
 /// Gradient descent on Ψ from an element flattened through itself (F₃₃ = −0.5).
 fn relax(model: StrainModel, lame: Lame) -> Mat3 {
-    let mut f = Mat3::from_diagonal(Vec3::new(1.0, 1.0, -0.5));
+    relax_from(model, lame, Mat3::from_diagonal(Vec3::new(1.0, 1.0, -0.5)))
+}
+
+/// Gradient descent on Ψ from `f`.
+fn relax_from(model: StrainModel, lame: Lame, mut f: Mat3) -> Mat3 {
     for _ in 0..4000 {
         f -= 0.05 * model.first_piola(f, lame);
     }
@@ -323,4 +327,38 @@ fn inverted_elements_recover_with_corotated_and_neo_hookean_not_with_green() {
         "Green ends at det {}",
         f.determinant()
     );
+}
+
+#[test]
+fn a_crushed_element_recovers_with_corotated_and_neo_hookean() {
+    // Issue 37: stable Neo-Hookean without its log term has a local minimum at F = 0
+    // (P(0) = 0, Hessian μ I), and an element crushed below J ≈ 0.024 collapsed to a point.
+    // With −½ μ′ log(I_C + 1), the Hessian at F = 0 vanishes and J > 0 is downhill.
+    let lame = unit(0.3);
+    for model in [StrainModel::Corotated, StrainModel::StableNeoHookean] {
+        for (scale, skew) in [(0.2154, 0.0), (0.05, 0.0), (0.1, 0.03), (0.01, 0.002)] {
+            let mut start = Mat3::from_diagonal(Vec3::splat(scale));
+            start.x_axis.y = skew;
+            let f = relax_from(model, lame, start);
+            println!(
+                "{model:?} from {scale} I (J = {:.1e}): ends at det {:.4}",
+                start.determinant(),
+                f.determinant()
+            );
+            assert!(
+                f.determinant() > 0.99 && model.energy_density(f, lame) < 1e-6,
+                "{model:?} from {scale}: det {}",
+                f.determinant()
+            );
+        }
+    }
+    // F = 0 itself stays a stationary point of stable Neo-Hookean (P(0) = 0), now a saddle:
+    // only a crush to exactly a point is left there.
+    let snh = StrainModel::StableNeoHookean;
+    assert!(
+        snh.first_piola(Mat3::ZERO, lame)
+            .abs_diff_eq(Mat3::ZERO, 1e-6)
+    );
+    let rest_of_a_point = snh.energy_density(Mat3::ZERO, lame);
+    assert!(snh.energy_density(Mat3::from_diagonal(Vec3::splat(0.05)), lame) < rest_of_a_point);
 }
