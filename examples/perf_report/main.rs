@@ -12,7 +12,10 @@
 
 #[cfg(feature = "bevy")]
 mod bevy_layer;
+mod box3d;
 mod contacts;
+#[path = "../common/rapier_box3d.rs"]
+mod rapier_box3d;
 #[path = "../common/rapier_boxes.rs"]
 mod rapier_boxes;
 mod rigid;
@@ -385,7 +388,7 @@ fn main() {
         "{:<48} {:>14} {:>14} {:>7}  note",
         "name", "ours_ns", "reference_ns", "ratio"
     );
-    // `--only particles|rigid|contacts|springs|scenario|snapshot|soft|bevy|dial` runs one group (bevy with `--features bevy`).
+    // `--only particles|rigid|contacts|box3d|springs|scenario|snapshot|soft|bevy|dial` runs one group (bevy with `--features bevy`).
     let only = std::env::args()
         .skip_while(|a| a != "--only")
         .nth(1)
@@ -404,6 +407,9 @@ fn main() {
     }
     if run("contacts") {
         contacts::contact_scenes(&cfg, quick);
+    }
+    if run("box3d") {
+        box3d::box3d_suite(quick);
     }
     if run("springs") {
         springs::implicit_springs(&cfg);

@@ -2,6 +2,7 @@
 //! them (the default `tools` feature).
 //!
 //! - [`scenes`]: the scene builders shared by tests, examples, benchmarks and scenarios;
+//! - [`box3d`]: Box3D's benchmark scenes (large_pyramid, many_pyramids, convex_pile);
 //! - [`scenario`]: RON files that build a scene, act on it on a timeline and check
 //!   expectations (the `hooke` command runs them, with the `cli` feature);
 //! - [`accuracy`]: the accuracy sweep, error against closed forms for each setting of the dial;
@@ -9,6 +10,7 @@
 //! - `plot` (feature `plot`): the font, axes and legend every chart of hooke's shares.
 
 pub mod accuracy;
+pub mod box3d;
 #[cfg(feature = "plot")]
 pub mod plot;
 pub mod scenario;

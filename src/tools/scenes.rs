@@ -400,7 +400,7 @@ pub const MAX_SCENE_BOXES: usize = 1 << 20;
 
 /// Refuses a box count past [`MAX_SCENE_BOXES`] (None: it overflowed) before anything is
 /// allocated.
-fn check_boxes(count: Option<usize>) -> Result<()> {
+pub(crate) fn check_boxes(count: Option<usize>) -> Result<()> {
     match count {
         Some(n) if n <= MAX_SCENE_BOXES => Ok(()),
         _ => Err(crate::core::error::Error::TooMany {

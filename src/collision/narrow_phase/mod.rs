@@ -227,6 +227,8 @@ pub struct Contacts {
     /// Touching pairs inside islands woken this step: the broad phase skipped them while
     /// they slept, but their manifolds still hold (nothing moved).
     pub(crate) woken: Vec<(Entity, Entity)>,
+    /// Pairs whose manifolds parry computed again in the last step (the others were reused).
+    pub(crate) updated: usize,
 }
 
 /// A touching pair, as reported by [`Contacts`].
@@ -339,6 +341,13 @@ impl Contacts {
             .map(|m| m.points.len())
             .sum();
         (m, p)
+    }
+
+    /// Pairs whose manifolds were computed again in the last step; the other pairs moved
+    /// less than [`crate::collision::ContactSettings::recycle_distance`] and kept theirs.
+    #[must_use]
+    pub fn updated_last_step(&self) -> usize {
+        self.updated
     }
 
     /// Number of touching pairs.
@@ -570,6 +579,7 @@ impl Contacts {
             pairs,
             step: record.step,
             woken,
+            updated: 0,
         })
     }
 }

@@ -154,6 +154,7 @@ pub(crate) fn update_contacts(
         // Zero, negative or not a number: no reuse.
         _ => 0.0,
     };
+    let mut updated = 0;
     for (&(a, b), &(sa, sb)) in bp.pairs.iter().zip(pair_slots.iter()) {
         let (Some(ca), Some(cb)) = (&bodies[sa as usize], &bodies[sb as usize]) else {
             continue;
@@ -192,6 +193,7 @@ pub(crate) fn update_contacts(
                             state.manifolds.clear();
                             state.workspace = None;
                         }
+                        updated += 1;
                         let reach = prediction + window;
                         let before = PointsKey::of(&state.manifolds);
                         let result = guarded(&mut failed, || {
@@ -270,6 +272,7 @@ pub(crate) fn update_contacts(
             }
         }
     }
+    contacts.updated = updated;
     let mut gone: Vec<_> = contacts
         .pairs
         .iter()

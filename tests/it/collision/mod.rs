@@ -1,5 +1,6 @@
 //! Contacts and queries: solver behaviour on stacks and impacts, tunnelling, recycling, the broad phase and spatial queries.
 
+mod box3d_scenes_stand_and_settle;
 mod broad_phase_hears_pose_changes;
 mod collider_parts_are_never_lost_or_nan;
 mod compound_part_frames;

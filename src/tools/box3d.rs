@@ -1,0 +1,333 @@
+//! Box3D's benchmark scenes (`shared/benchmarks.c` in erincatto/box3d), rebuilt through
+//! hooke's public API so that tests, `examples/perf_report` and `benches/` measure the
+//! scenes the field compares engines on, not scenes hooke chose for itself.
+//!
+//! Box3D runs every scene at 1/60 s with 4 substeps, gravity −10 m/s², friction 0.6,
+//! contact stiffness 30 Hz at damping ratio 10 and a push-out of at most 3 m/s (hooke's
+//! defaults for the last three), times the steps after one untimed step, and keeps the
+//! fastest of 4 runs. Its boxes are hulls (`b3MakeBoxHull`); here they are cuboids, as
+//! rapier's users and hooke's would build them (parry's box–box manifold). Sleeping is off
+//! where Box3D turns it off (the pyramids) and at its default, on, for the convex pile.
+
+use bevy_ecs::prelude::*;
+use glam::{Quat, Vec3};
+
+use crate::collision::{Collider, ColliderDensity, Friction};
+use crate::core::error::Result;
+use crate::core::time::PhysicsTime;
+use crate::particles::Gravity;
+use crate::particles::Position;
+use crate::plugins::{PhysicsPlugins, PhysicsWorldExt};
+use crate::rigid::RigidBody;
+use crate::sleep::SleepSettings;
+use crate::tools::scenes::BoxSpec;
+
+/// Box3D's friction on every shape of its benchmark scenes.
+pub const FRICTION: f32 = 0.6;
+
+/// One scene of the suite.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Scene {
+    /// `large_pyramid`: a 2-D pyramid of 1 m cubes, 100 at its base (5,050 cubes, density
+    /// 100 kg/m³), on a 800 m × 800 m ground; 200 steps.
+    LargePyramid,
+    /// `many_pyramids`: 14 × 14 pyramids of base 10 (55 cubes each, 10,780 in all, density
+    /// 100 kg/m³); 100 steps.
+    ManyPyramids,
+    /// `convex_pile`: 8 × 8 × 80 = 5,120 copies of one hull of 32 random points on a
+    /// sphere of radius 2 m (density 1000 kg/m³), dropped in a grid that collapses into a
+    /// pile; 500 steps.
+    ConvexPile,
+}
+
+impl Scene {
+    /// The suite, in Box3D's order.
+    pub const ALL: [Scene; 3] = [Scene::ConvexPile, Scene::LargePyramid, Scene::ManyPyramids];
+
+    /// Box3D's name for it.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Scene::LargePyramid => "large_pyramid",
+            Scene::ManyPyramids => "many_pyramids",
+            Scene::ConvexPile => "convex_pile",
+        }
+    }
+
+    /// The steps Box3D times (after one untimed step).
+    #[must_use]
+    pub fn steps(self) -> usize {
+        match self {
+            Scene::LargePyramid => 200,
+            Scene::ManyPyramids => 100,
+            Scene::ConvexPile => 500,
+        }
+    }
+
+    /// Whether bodies may sleep (Box3D turns sleeping off for the pyramids).
+    #[must_use]
+    pub fn sleeping(self) -> bool {
+        matches!(self, Scene::ConvexPile)
+    }
+
+    /// The scene's size: Box3D's full size, or its `BENCHMARK_DEBUG` size (a pyramid of base
+    /// 20, 3 × 3 pyramids, 10 layers of hulls) when `small`.
+    #[must_use]
+    pub fn bodies(self, small: bool) -> SceneBodies {
+        match (self, small) {
+            (Scene::LargePyramid, false) => SceneBodies::Boxes(large_pyramid(100)),
+            (Scene::LargePyramid, true) => SceneBodies::Boxes(large_pyramid(20)),
+            (Scene::ManyPyramids, false) => SceneBodies::Boxes(many_pyramids(14, 14, 10)),
+            (Scene::ManyPyramids, true) => SceneBodies::Boxes(many_pyramids(3, 3, 10)),
+            (Scene::ConvexPile, false) => SceneBodies::Hulls(convex_pile(80)),
+            (Scene::ConvexPile, true) => SceneBodies::Hulls(convex_pile(10)),
+        }
+    }
+
+    /// Density of the dynamic bodies (kg/m³).
+    #[must_use]
+    pub fn density(self) -> f32 {
+        match self {
+            Scene::LargePyramid | Scene::ManyPyramids => 100.0,
+            Scene::ConvexPile => 1000.0,
+        }
+    }
+}
+
+/// What a scene is made of, for any engine to build.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SceneBodies {
+    /// Boxes (the first is the static ground).
+    Boxes(Vec<BoxSpec>),
+    /// A static ground box and copies of one convex hull.
+    Hulls(HullPile),
+}
+
+/// The convex pile: a ground box, one hull's points and where its copies start.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HullPile {
+    /// The static ground.
+    pub ground: BoxSpec,
+    /// The hull's points (m, in its own frame).
+    pub points: Vec<Vec3>,
+    /// The copies' starting centres (m).
+    pub positions: Vec<Vec3>,
+}
+
+fn ground(half_x: f32, half_z: f32) -> BoxSpec {
+    BoxSpec {
+        half: Vec3::new(half_x, 1.0, half_z),
+        position: Vec3::new(0.0, -1.0, 0.0),
+        rotation: Quat::IDENTITY,
+        fixed: true,
+    }
+}
+
+fn cube(half: f32, position: Vec3) -> BoxSpec {
+    BoxSpec {
+        half: Vec3::splat(half),
+        position,
+        rotation: Quat::IDENTITY,
+        fixed: false,
+    }
+}
+
+/// `CreateLargePyramid`: rows of 1 m cubes in the x–y plane, `base` in the bottom row.
+#[must_use]
+fn large_pyramid(base: usize) -> Vec<BoxSpec> {
+    let h = 0.5f32;
+    let mut out = vec![ground(400.0, 400.0)];
+    for i in 0..base {
+        let y = (2.0 * i as f32 + 1.0) * h;
+        for j in i..base {
+            let x = (i as f32 + 1.0) * h + 2.0 * (j - i) as f32 * h - h * base as f32;
+            out.push(cube(h, Vec3::new(x, y, 0.0)));
+        }
+    }
+    out
+}
+
+/// `CreateManyPyramids`: `rows` × `columns` pyramids of `base` cubes of 1 m, spread over a
+/// ground sized to hold them.
+#[must_use]
+fn many_pyramids(rows: usize, columns: usize, base: usize) -> Vec<BoxSpec> {
+    let extent = 0.5f32;
+    let ground_extent = extent * columns as f32 * (base as f32 + 1.0);
+    let mut out = vec![ground(ground_extent, ground_extent)];
+    let base_width = 2.0 * extent * base as f32;
+    let base_z = -ground_extent + 2.0 * extent;
+    let delta_z = 2.0 * (ground_extent - 2.0 * extent) / (rows as f32 - 1.0).max(1.0);
+    for i in 0..rows {
+        let z = base_z + i as f32 * delta_z;
+        for j in 0..columns {
+            let centre_x = -ground_extent + j as f32 * (base_width + 2.0 * extent) + 2.0 * extent;
+            for r in 0..base {
+                let y = (2.0 * r as f32 + 1.0) * extent;
+                for c in r..base {
+                    let x =
+                        (r as f32 + 1.0) * extent + 2.0 * (c - r) as f32 * extent + centre_x - 0.5;
+                    out.push(cube(extent, Vec3::new(x, y, z)));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The linear congruential generator Box3D's convex pile uses (PEEL's `BasicRandom`), so the
+/// hull is the same point set: the state times 2147001325 plus 715136305, modulo 2³².
+struct PileRandom(u32);
+
+impl PileRandom {
+    /// A float in [−0.5, 0.5] from the low 16 bits of the next state.
+    fn float(&mut self) -> f32 {
+        self.0 = self.0.wrapping_mul(2_147_001_325).wrapping_add(715_136_305);
+        (self.0 & 0xffff) as f32 / 65535.0 - 0.5
+    }
+
+    /// A unit vector: rejection-sampled inside the sphere of radius 0.5, then normalised.
+    fn unit(&mut self) -> Vec3 {
+        loop {
+            let p = Vec3::new(self.float(), self.float(), self.float());
+            if p.length_squared() <= 0.25 {
+                return p.normalize();
+            }
+        }
+    }
+}
+
+/// `CreateConvexPile`: one hull of 32 random points on a sphere of radius 2 m (seed 42),
+/// copied over an 8 × 8 grid 4 m apart, `layers` high, on a 500 m × 500 m ground.
+#[must_use]
+fn convex_pile(layers: usize) -> HullPile {
+    let amplitude = 2.0f32;
+    let mut rng = PileRandom(42);
+    let points = (0..32).map(|_| amplitude * rng.unit()).collect();
+    let scatter = 2.0 * amplitude;
+    let mut positions = Vec::new();
+    for layer in 0..layers {
+        for z in 0..8 {
+            for x in 0..8 {
+                positions.push(Vec3::new(
+                    (x as f32 - 4.0) * scatter,
+                    amplitude + 2.0 * amplitude * layer as f32,
+                    (z as f32 - 4.0) * scatter,
+                ));
+            }
+        }
+    }
+    HullPile {
+        ground: ground(250.0, 250.0),
+        points,
+        positions,
+    }
+}
+
+/// A world set as Box3D's benchmark sets its own, at hooke's defaults otherwise:
+/// [`PhysicsPlugins`], 1/60 s with 4 substeps, gravity −10 m/s², sleeping as the scene says.
+///
+/// # Errors
+/// Never for the suite's constants; as [`PhysicsTime::new`] otherwise.
+pub fn world(scene: Scene) -> Result<World> {
+    let mut world = World::new();
+    world.insert_resource(PhysicsTime::new(1.0 / 60.0, 4)?);
+    world.add_physics(PhysicsPlugins);
+    world.insert_resource(Gravity::new(Vec3::new(0.0, -10.0, 0.0))?);
+    world.resource_mut::<SleepSettings>().enabled = scene.sleeping();
+    Ok(world)
+}
+
+/// Spawns `bodies` the way a game would (`RigidBody`, `Collider`, `Position`, a density
+/// and Box3D's friction on each); returns the dynamic bodies in order.
+///
+/// # Errors
+/// [`crate::core::error::Error::TooMany`] past [`crate::tools::scenes::MAX_SCENE_BOXES`]; constructor errors for
+/// a degenerate hull.
+pub fn spawn(world: &mut World, bodies: &SceneBodies, density: f32) -> Result<Vec<Entity>> {
+    let mut out = Vec::new();
+    let mut put = |world: &mut World, collider: Collider, at: Vec3, fixed: bool| {
+        let kind = if fixed {
+            RigidBody::Static
+        } else {
+            RigidBody::Dynamic
+        };
+        let e = world
+            .spawn((
+                kind,
+                collider,
+                Position::from(at),
+                ColliderDensity(density),
+                Friction(FRICTION),
+            ))
+            .id();
+        if !fixed {
+            out.push(e);
+        }
+    };
+    match bodies {
+        SceneBodies::Boxes(specs) => {
+            crate::tools::scenes::check_boxes(Some(specs.len()))?;
+            for b in specs {
+                put(
+                    world,
+                    Collider::cuboid(b.half.x, b.half.y, b.half.z)?,
+                    b.position,
+                    b.fixed,
+                );
+            }
+        }
+        SceneBodies::Hulls(pile) => {
+            crate::tools::scenes::check_boxes(Some(pile.positions.len()))?;
+            let g = pile.ground;
+            put(
+                world,
+                Collider::cuboid(g.half.x, g.half.y, g.half.z)?,
+                g.position,
+                true,
+            );
+            let hull = Collider::convex_hull(&pile.points)?;
+            for &at in &pile.positions {
+                put(world, hull.clone(), at, false);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// A world holding `scene` at its full size (or Box3D's debug size when `small`), ready for
+/// its untimed first step; returns it and the dynamic bodies.
+///
+/// # Errors
+/// As [`world`] and [`spawn`].
+pub fn build(scene: Scene, small: bool) -> Result<(World, Vec<Entity>)> {
+    let mut w = world(scene)?;
+    let bodies = spawn(&mut w, &scene.bodies(small), scene.density())?;
+    Ok((w, bodies))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_suite_has_box3ds_body_counts() {
+        let count = |s: Scene| match s.bodies(false) {
+            SceneBodies::Boxes(b) => b.len() - 1,
+            SceneBodies::Hulls(h) => h.positions.len(),
+        };
+        assert_eq!(count(Scene::LargePyramid), 5050);
+        assert_eq!(count(Scene::ManyPyramids), 10_780);
+        assert_eq!(count(Scene::ConvexPile), 5120);
+    }
+
+    #[test]
+    fn the_pile_hull_points_lie_on_the_sphere() {
+        let pile = convex_pile(1);
+        assert_eq!(pile.points.len(), 32);
+        for p in &pile.points {
+            assert!((p.length() - 2.0).abs() < 1e-5);
+        }
+        // Deterministic: the same points each time.
+        assert_eq!(pile.points, convex_pile(1).points);
+    }
+}

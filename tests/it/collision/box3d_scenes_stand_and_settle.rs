@@ -1,0 +1,138 @@
+//! Box3D's benchmark scenes (`hooke::tools::box3d`, rebuilt from its `shared/benchmarks.c`)
+//! at the defaults: the pyramids stand through the steps Box3D times (and move as rapier's
+//! do), and the convex pile falls into a pile without anything passing through the ground
+//! or running away. These
+//! are the scenes `perf_report` and `benches/box3d.rs` time against rapier, so what is
+//! timed is also shown to be right.
+
+use glam::Vec3;
+use hooke::prelude::*;
+use hooke::rigid::Rotation;
+use hooke::tools::box3d::{self, Scene, SceneBodies};
+
+#[path = "../../../examples/common/rapier_box3d.rs"]
+mod rapier_box3d;
+
+/// How a pyramid moved over the scene's steps: the largest sideways and downward moves of
+/// any box (m).
+#[derive(Debug)]
+struct Moved {
+    sideways: f32,
+    sink: f32,
+}
+
+fn moved(starts: &[Vec3], ends: impl Iterator<Item = Vec3>) -> Moved {
+    let mut out = Moved {
+        sideways: 0.0,
+        sink: 0.0,
+    };
+    for (x, x0) in ends.zip(starts) {
+        let d = x - *x0;
+        out.sideways = out.sideways.max(d.x.abs().max(d.z.abs()));
+        out.sink = out.sink.max(-d.y);
+    }
+    out
+}
+
+#[test]
+fn box3ds_large_pyramid_and_many_pyramids_stand_as_in_rapier() {
+    for scene in [Scene::LargePyramid, Scene::ManyPyramids] {
+        let bodies = scene.bodies(false);
+        let SceneBodies::Boxes(specs) = &bodies else {
+            unreachable!("the pyramids are boxes")
+        };
+        let starts: Vec<Vec3> = specs
+            .iter()
+            .filter(|b| !b.fixed)
+            .map(|b| b.position)
+            .collect();
+        let (mut w, boxes) = box3d::build(scene, false).unwrap();
+        let (mut r, handles) = rapier_box3d::rapier_scene(scene, &bodies);
+        for _ in 0..scene.steps() {
+            w.step_physics();
+            r.step();
+        }
+        assert_eq!(w.resource::<PhysicsDiagnostics>().quarantined_total, 0);
+        let ours = moved(
+            &starts,
+            boxes.iter().map(|&e| w.get::<Position>(e).unwrap().get()),
+        );
+        let theirs = moved(&starts, handles.iter().map(|&h| r.bodies[h].translation()));
+        let tilt = boxes
+            .iter()
+            .map(|&e| {
+                w.get::<Rotation>(e)
+                    .unwrap()
+                    .0
+                    .angle_between(glam::Quat::IDENTITY)
+            })
+            .fold(0.0, f32::max);
+        println!(
+            "{}: {} steps; hooke {ours:?}, most tilted {tilt:.4} rad; rapier {theirs:?}",
+            scene.name(),
+            scene.steps()
+        );
+        // None toppled or slid off: every box keeps its face down.
+        assert!(tilt < 0.05, "{}: a box tilted {tilt} rad", scene.name());
+        // The 100-row pyramid sinks 0.7 m at its top and spreads 0.2 m at its foot in both
+        // engines: 30 Hz contacts, each compressed by the weight above it. Within 10 % (and
+        // 5 mm) of rapier's, the same contact model.
+        for (what, a, b) in [
+            ("sink", ours.sink, theirs.sink),
+            ("sideways", ours.sideways, theirs.sideways),
+        ] {
+            assert!(
+                (a - b).abs() < 0.1 * b + 0.005,
+                "{}: {what} {a} m against rapier's {b} m",
+                scene.name()
+            );
+        }
+    }
+}
+
+/// Lowest centre, the fastest speed (m/s), the hulls above 5 cm/s and the highest centre
+/// after `steps` steps of the pile.
+fn pile(small: bool, steps: usize) -> (f32, f32, usize, f32) {
+    let (mut w, bodies) = box3d::build(Scene::ConvexPile, small).unwrap();
+    let mut lowest = f32::INFINITY;
+    for _ in 0..steps {
+        w.step_physics();
+        for &e in &bodies {
+            lowest = lowest.min(w.get::<Position>(e).unwrap().get().y);
+        }
+    }
+    assert_eq!(w.resource::<PhysicsDiagnostics>().quarantined_total, 0);
+    let speeds: Vec<f32> = bodies
+        .iter()
+        .map(|&e| w.get::<LinearVelocity>(e).unwrap().get().length())
+        .collect();
+    let fastest = speeds.iter().copied().fold(0.0, f32::max);
+    let moving = speeds.iter().filter(|&&v| v > 0.05).count();
+    let highest = bodies
+        .iter()
+        .map(|&e| w.get::<Position>(e).unwrap().get().y)
+        .fold(f32::NEG_INFINITY, f32::max);
+    (lowest, fastest, moving, highest)
+}
+
+#[test]
+fn box3ds_convex_pile_falls_into_a_pile_that_settles() {
+    // Each hull reaches at least 1.6 m from its centre in every direction far from its
+    // points' gaps; one resting on the ground has its centre above that.
+    let (lowest, fastest, _, highest) = pile(false, Scene::ConvexPile.steps());
+    println!(
+        "convex_pile, 5,120 hulls, 500 steps: lowest centre {lowest:.2} m, fastest {fastest:.1} m/s, highest {highest:.1} m"
+    );
+    assert!(lowest > 1.0, "through the ground: {lowest}");
+    // The top layer starts 318 m up: √(2 g h) = 80 m/s at the ground.
+    assert!(fastest < 85.0, "{fastest}");
+    // Box3D's debug size (10 layers, 640 hulls) settles within 15 s: all but a few hulls
+    // rolling off the pile's foot (5 above 5 cm/s here, 16 in rapier).
+    let (lowest, _, moving, highest) = pile(true, 900);
+    println!(
+        "convex_pile, 640 hulls, 15 s: lowest centre {lowest:.2} m, {moving} above 5 cm/s, highest {highest:.1} m"
+    );
+    assert!(lowest > 1.0, "{lowest}");
+    assert!(moving <= 10, "still moving: {moving}");
+    assert!(highest < 20.0, "no pile: {highest}");
+}
