@@ -79,7 +79,7 @@ pub(crate) fn check_soft_stability(
         (
             Entity,
             Ref<SoftBody>,
-            &Nodes,
+            Option<&Nodes>,
             &mut SoftStability,
             Has<ImplicitEuler>,
             Option<&IntegratorOverride>,
@@ -109,7 +109,8 @@ pub(crate) fn check_soft_stability(
         // at rest), and explicit steps without damping keep the energy an inversion stores
         // ringing through inversion for ever (a jelly started mirrored stayed half inside
         // out): BDF2 brings it back.
-        if body.stats.inverted > 0 || (fresh && has_inverted_elements(&body, nodes)) {
+        let started_inverted = fresh && nodes.is_some_and(|n| has_inverted_elements(&body, n));
+        if body.stats.inverted > 0 || started_inverted {
             if policy.rescue(method).is_some() {
                 put_rescue(&mut commands, e, Rescue::Implicit(ImplicitScheme::Bdf2));
             }
