@@ -197,7 +197,7 @@ fn wake_hit_islands(
     let mut asleep_pairs = Vec::new();
     // The broad phase pairs a sleeper with nothing static either: (sleeper, pair).
     let mut grounded = Vec::new();
-    for (&(a, b), state) in &contacts.pairs {
+    for (&(a, b), state) in contacts.pairs.iter() {
         if state.sensor {
             continue;
         }

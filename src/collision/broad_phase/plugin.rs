@@ -22,7 +22,7 @@ type MovingCollider<'a> = (
     &'a mut ColliderAabb,
 );
 
-/// Boxes of moving colliders, grown by how far they can travel in a step.
+/// Boxes of moving colliders, swept over how far they can travel in a step.
 pub(crate) fn update_moving_aabbs(
     time: Res<PhysicsTime>,
     settings: Res<ContactSettings>,
@@ -32,10 +32,13 @@ pub(crate) fn update_moving_aabbs(
     for (c, x, q, com, v, w, mut aabb) in &mut colliders {
         let b = c.shape().compute_aabb(&shape_pose(x.0, q.0, com));
         let spin = w.map_or(0.0, |w| w.0.length() * radius(c, com));
-        let grow = settings.margin + (v.0.length() + spin) * dt;
+        // Swept along the velocity, not grown by the speed every way: bodies falling side
+        // by side (Box3D's convex pile) would otherwise pair with every neighbour.
+        let grow = Vec3::splat(settings.margin + spin * dt);
+        let sweep = Vec3::from(v.0) * dt;
         *aabb = ColliderAabb {
-            min: b.mins - Vec3::splat(grow),
-            max: b.maxs + Vec3::splat(grow),
+            min: b.mins - grow + sweep.min(Vec3::ZERO),
+            max: b.maxs + grow + sweep.max(Vec3::ZERO),
         };
     }
 }

@@ -2,16 +2,16 @@
 
 pub(crate) mod ccd;
 pub(crate) mod fetch;
+pub(crate) mod pairs;
 pub(crate) mod plugin;
 pub(crate) mod points;
-
-use bevy_platform::collections::HashMap;
 
 use bevy_ecs::prelude::*;
 use glam::Vec3;
 use parry3d::math::Pose;
 use parry3d::query::{ContactManifold, ContactManifoldsWorkspace};
 
+use crate::collision::narrow_phase::pairs::PairTable;
 use crate::collision::narrow_phase::points::{MAX_POINTS, kept_normal_impulse};
 
 /// What each contact point carries from step to step: its accumulated normal impulse, for
@@ -156,7 +156,6 @@ pub(crate) struct PairState {
     pub workspace: Option<ContactManifoldsWorkspace>,
     pub touching: bool,
     pub sensor: bool,
-    pub seen: u64,
     /// Where the last full update ran, while its manifolds may be reused.
     pub recycle: Option<Recycle>,
     /// This step's time-of-impact manifold for a fast pair (see the `ccd` module): solved
@@ -206,7 +205,6 @@ impl PairState {
             workspace: None,
             touching: false,
             sensor: false,
-            seen: 0,
             recycle: None,
             cast: None,
         }
@@ -222,7 +220,10 @@ impl PairState {
 /// read it after a step to see what touches what.
 #[derive(Resource, Default)]
 pub struct Contacts {
-    pub(crate) pairs: HashMap<(Entity, Entity), PairState>,
+    pub(crate) pairs: PairTable,
+    /// The slots of the pairs the narrow phase went through this step, in the broad
+    /// phase's order: the solver's preparation takes them from here.
+    pub(crate) active: Vec<u32>,
     pub(crate) step: u64,
     /// Touching pairs inside islands woken this step: the broad phase skipped them while
     /// they slept, but their manifolds still hold (nothing moved).
@@ -514,15 +515,15 @@ impl Contacts {
     pub(crate) fn to_record(&self) -> ContactsRecord {
         let mut pairs: Vec<PairRecord> = self
             .pairs
-            .iter()
-            .map(|(&(a, b), s)| PairRecord {
+            .iter_seen()
+            .map(|(&(a, b), s, seen)| PairRecord {
                 a,
                 b,
+                seen,
                 manifolds: s.manifolds.clone(),
                 workspace: s.workspace.clone(),
                 touching: s.touching,
                 sensor: s.sensor,
-                seen: s.seen,
                 recycle: s.recycle,
                 cast: s.cast.as_deref().cloned(),
             })
@@ -544,8 +545,7 @@ impl Contacts {
         let both = |(a, b): (Entity, Entity)| {
             Ok::<_, Option<Entity>>(key(map(a).ok_or(Some(a))?, map(b).ok_or(Some(b))?))
         };
-        let mut pairs = HashMap::default();
-        pairs.reserve(record.pairs.len());
+        let mut pairs = PairTable::default();
         for mut p in record.pairs {
             if !p.manifolds.iter().chain(&p.cast).all(kept_in_range) {
                 return Err(None);
@@ -564,10 +564,10 @@ impl Contacts {
                     workspace: p.workspace,
                     touching: p.touching,
                     sensor: p.sensor,
-                    seen: p.seen,
                     recycle: p.recycle,
                     cast: p.cast.map(Box::new),
                 },
+                p.seen,
             );
         }
         let woken = record
@@ -577,6 +577,7 @@ impl Contacts {
             .collect::<Result<_, _>>()?;
         Ok(Self {
             pairs,
+            active: Vec::new(),
             step: record.step,
             woken,
             updated: 0,

@@ -10,7 +10,7 @@ use crate::collision::ContactFilter;
 use crate::collision::broad_phase::BroadPhase;
 use crate::collision::narrow_phase::fetch::Wanted;
 use crate::collision::narrow_phase::points::{PointsKey, choose_changed_points};
-use crate::collision::narrow_phase::{Contacts, PairState, Recycle};
+use crate::collision::narrow_phase::{Contacts, Recycle};
 use crate::collision::{Collider, ContactEnded, ContactSettings, ContactStarted, Sensor};
 use crate::collision::{radius, shape_pose};
 use crate::core::rest::Sleeping;
@@ -147,6 +147,7 @@ pub(crate) fn update_contacts(
     let dt = time.dt();
     contacts.step += 1;
     contacts.woken.clear();
+    contacts.active.clear();
     let step = contacts.step;
     let touch = 0.25 * settings.margin;
     let window = match settings.recycle_distance {
@@ -161,8 +162,11 @@ pub(crate) fn update_contacts(
         };
         let (pose_a, pose_b) = (&ca.pose, &cb.pose);
         let sensor = ca.sensor || cb.sensor;
-        let state = contacts.pairs.entry((a, b)).or_insert_with(PairState::new);
-        state.seen = step;
+        let slot = contacts.pairs.see((a, b), step);
+        contacts.active.push(slot);
+        let Some(state) = contacts.pairs.at_mut(slot) else {
+            continue;
+        };
         state.sensor = sensor;
         state.cast = None;
         // parry can still panic on shapes at the edge of its domain (EPA's index panic was
@@ -275,11 +279,10 @@ pub(crate) fn update_contacts(
     contacts.updated = updated;
     let mut gone: Vec<_> = contacts
         .pairs
-        .iter()
+        .unseen(step)
         // A pair with a sleeping side is not re-formed while it sleeps, but it still
         // touches: keep it (and its warm-start impulses) until the island wakes.
-        .filter(|((a, b), s)| s.seen != step && !(sleeping.contains(*a) || sleeping.contains(*b)))
-        .map(|(k, s)| (*k, s.touching))
+        .filter(|((a, b), _)| !(sleeping.contains(*a) || sleeping.contains(*b)))
         .collect();
     gone.sort_unstable_by_key(|g| g.0);
     for ((a, b), touching) in gone {

@@ -142,7 +142,8 @@ pub(crate) struct ManifoldConstraint {
     pub threshold: f32,
     pub first: u32,
     pub count: u32,
-    pub pair: (Entity, Entity),
+    /// The pair's slot in the pair table, where its impulses are written back.
+    pub pair: u32,
     pub manifold: u32,
     /// Lever arms from each centre of mass to the manifold's centre, where friction acts.
     pub centre_a: Vec3A,

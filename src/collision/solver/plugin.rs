@@ -91,7 +91,7 @@ pub(crate) fn relax_pass(
             let m = solved.constraint;
             let Some(tracked) = contacts
                 .pairs
-                .get_mut(&m.pair)
+                .at_mut(m.pair)
                 .and_then(|s| s.manifolds.get_mut(m.manifold as usize))
             else {
                 continue;

@@ -6,7 +6,6 @@ use glam::{Mat3A, Quat, Vec3, Vec3A};
 use parry3d::math::Pose;
 
 use crate::collision::ContactFilter;
-use crate::collision::broad_phase::BroadPhase;
 use crate::collision::narrow_phase::fetch::Wanted;
 use crate::collision::narrow_phase::points::MAX_POINTS;
 use crate::collision::narrow_phase::{Contacts, FrozenGeometry};
@@ -20,7 +19,7 @@ use crate::rigid::{AngularVelocity, CenterOfMass, Inertia, Rotation};
 
 /// Constraint building's reused buffers: the bodies of the step's contacts, the contact
 /// pairs with their slots among them, and the bodies' sides.
-type PrepareBuffers = (Wanted, Vec<(Entity, Entity, u32, u32)>, Vec<Option<Side>>);
+type PrepareBuffers = (Wanted, Vec<(u32, u32, u32)>, Vec<Option<Side>>);
 
 type PreparedBody<'a> = (
     Entity,
@@ -269,7 +268,6 @@ pub(crate) fn prepare_contacts(
     mut solver: ResMut<ContactSolver>,
     mut active: ResMut<ConstraintsActive>,
     mut contacts: ResMut<Contacts>,
-    bp: Res<BroadPhase>,
     settings: Res<ContactSettings>,
     bodies: Query<PreparedBody, (With<Collider>, ContactFilter)>,
     mut buffers: Local<PrepareBuffers>,
@@ -281,14 +279,17 @@ pub(crate) fn prepare_contacts(
     let (wanted, pairs, sides) = &mut *buffers;
     wanted.clear();
     pairs.clear();
-    for &(ea, eb) in bp.pairs.iter().chain(&contacts.woken) {
-        let Some(state) = contacts.pairs.get(&(ea, eb)) else {
+    // The pairs the narrow phase went through (in the broad phase's order, by slot), then
+    // those of islands woken this step.
+    let woken = contacts.woken.iter().filter_map(|k| contacts.pairs.slot(k));
+    for slot in contacts.active.iter().copied().chain(woken) {
+        let Some(((ea, eb), state)) = contacts.pairs.pair_at(slot) else {
             continue;
         };
         if state.sensor || state.solved().all(|m| m.points.is_empty()) {
             continue;
         }
-        pairs.push((ea, eb, wanted.slot(ea) as u32, wanted.slot(eb) as u32));
+        pairs.push((slot, wanted.slot(ea) as u32, wanted.slot(eb) as u32));
     }
     sides.clear();
     sides.resize_with(wanted.len(), || None);
@@ -304,8 +305,8 @@ pub(crate) fn prepare_contacts(
     }
     // Freezing a manifold's geometry is bookkeeping, not a change anyone listens for.
     let contacts = contacts.bypass_change_detection();
-    for &(ea, eb, sa, sb) in pairs.iter() {
-        let Some(state) = contacts.pairs.get_mut(&(ea, eb)) else {
+    for &(slot, sa, sb) in pairs.iter() {
+        let Some(state) = contacts.pairs.at_mut(slot) else {
             continue;
         };
         let (sa, sb) = (sa as usize, sb as usize);
@@ -401,7 +402,7 @@ pub(crate) fn prepare_contacts(
                 threshold,
                 first,
                 count: s.inputs.len() as u32 - first,
-                pair: (ea, eb),
+                pair: slot,
                 manifold: mi as u32,
                 centre_a: Vec3A::from(f.centre[0]),
                 centre_b: Vec3A::from(f.centre[1]),

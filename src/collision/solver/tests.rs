@@ -67,7 +67,7 @@ fn solver_with(bodies: usize, pairs: &[(u32, u32)]) -> ContactSolver {
             threshold: 1.0,
             first: mi as u32,
             count: 1,
-            pair: (Entity::PLACEHOLDER, Entity::PLACEHOLDER),
+            pair: u32::MAX,
             manifold: 0,
             centre_a: Vec3A::ZERO,
             centre_b: Vec3A::ZERO,

@@ -1,0 +1,172 @@
+//! The pair table: every broad-phase pair's [`PairState`] in a slot array, found by key
+//! through a small index.
+//!
+//! Why not a map of states: a step reads every pair's state three times (the narrow phase,
+//! the solver's preparation, the impulses written back). With the states inline in a hash
+//! map, each of those was a probe into a table of 20,000 entries of ~100 bytes, and on
+//! Box3D's convex pile a fifth of the step waited on those lines. Here the narrow phase
+//! probes the index once and hands the later stages the slot, and the states sit in one
+//! array that the end-of-step sweep reads as a dense list of step numbers.
+
+use bevy_ecs::prelude::Entity;
+use bevy_platform::collections::HashMap;
+
+use crate::collision::narrow_phase::PairState;
+
+/// A pair's key: its lower entity, then its higher one.
+pub(crate) type PairKey = (Entity, Entity);
+
+/// The pair states, each in a slot that stays its own until the pair is removed.
+#[derive(Default)]
+pub(crate) struct PairTable {
+    index: HashMap<PairKey, u32>,
+    /// Per slot: the pair's key and state, `None` when free.
+    slots: Vec<Option<(PairKey, PairState)>>,
+    /// Per slot: the narrow-phase step that last saw the pair.
+    seen: Vec<u64>,
+    free: Vec<u32>,
+}
+
+impl PairTable {
+    /// The number of pairs.
+    pub fn len(&self) -> usize {
+        self.index.len()
+    }
+
+    /// True when there is no pair.
+    pub fn is_empty(&self) -> bool {
+        self.index.is_empty()
+    }
+
+    /// The slot of `key`, if it is a pair.
+    #[inline]
+    pub fn slot(&self, key: &PairKey) -> Option<u32> {
+        self.index.get(key).copied()
+    }
+
+    /// The state of `key`.
+    pub fn get(&self, key: &PairKey) -> Option<&PairState> {
+        self.slot(key).and_then(|s| self.at(s))
+    }
+
+    /// The state in `slot` (`None` for a free or unknown slot).
+    #[inline]
+    pub fn at(&self, slot: u32) -> Option<&PairState> {
+        self.slots.get(slot as usize)?.as_ref().map(|(_, s)| s)
+    }
+
+    /// The key and state in `slot`.
+    #[inline]
+    pub fn pair_at(&self, slot: u32) -> Option<(PairKey, &PairState)> {
+        self.slots
+            .get(slot as usize)?
+            .as_ref()
+            .map(|(k, s)| (*k, s))
+    }
+
+    /// The state in `slot`, to change.
+    #[inline]
+    pub fn at_mut(&mut self, slot: u32) -> Option<&mut PairState> {
+        self.slots.get_mut(slot as usize)?.as_mut().map(|(_, s)| s)
+    }
+
+    /// The slot of `key`, a new pair's when it is not one yet, marked seen at `step`.
+    pub fn see(&mut self, key: PairKey, step: u64) -> u32 {
+        let slot = match self.index.get(&key) {
+            Some(&s) => s,
+            None => self.insert(key, PairState::new(), step),
+        };
+        self.seen[slot as usize] = step;
+        slot
+    }
+
+    /// Adds `key` with `state`, last seen at `seen`; returns its slot. Replaces the state of
+    /// a pair that is already there.
+    pub fn insert(&mut self, key: PairKey, state: PairState, seen: u64) -> u32 {
+        if let Some(&slot) = self.index.get(&key) {
+            self.slots[slot as usize] = Some((key, state));
+            self.seen[slot as usize] = seen;
+            return slot;
+        }
+        let slot = match self.free.pop() {
+            Some(s) => {
+                self.slots[s as usize] = Some((key, state));
+                self.seen[s as usize] = seen;
+                s
+            }
+            None => {
+                self.slots.push(Some((key, state)));
+                self.seen.push(seen);
+                (self.slots.len() - 1) as u32
+            }
+        };
+        self.index.insert(key, slot);
+        slot
+    }
+
+    /// Removes `key`; returns its state.
+    pub fn remove(&mut self, key: &PairKey) -> Option<PairState> {
+        let slot = self.index.remove(key)?;
+        self.free.push(slot);
+        self.slots[slot as usize].take().map(|(_, s)| s)
+    }
+
+    /// The pairs not seen at `step`, with whether they touch.
+    pub fn unseen(&self, step: u64) -> impl Iterator<Item = (PairKey, bool)> + '_ {
+        self.seen
+            .iter()
+            .enumerate()
+            .filter(move |&(_, &s)| s != step)
+            .filter_map(|(i, _)| self.slots[i].as_ref().map(|(k, s)| (*k, s.touching)))
+    }
+
+    /// Every pair with its state, in slot order.
+    pub fn iter(&self) -> impl Iterator<Item = (&PairKey, &PairState)> {
+        self.slots.iter().flatten().map(|(k, s)| (k, s))
+    }
+
+    /// Every pair with its state and the step that last saw it, in slot order.
+    pub fn iter_seen(&self) -> impl Iterator<Item = (&PairKey, &PairState, u64)> {
+        self.slots
+            .iter()
+            .zip(&self.seen)
+            .filter_map(|(e, &seen)| e.as_ref().map(|(k, s)| (k, s, seen)))
+    }
+
+    /// Every pair's state, in slot order.
+    pub fn values(&self) -> impl Iterator<Item = &PairState> {
+        self.iter().map(|(_, s)| s)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn key(a: u32, b: u32) -> PairKey {
+        (
+            Entity::from_raw_u32(a).unwrap(),
+            Entity::from_raw_u32(b).unwrap(),
+        )
+    }
+
+    #[test]
+    fn slots_are_kept_until_removed_and_reused_after() {
+        let mut t = PairTable::default();
+        let a = t.see(key(1, 2), 1);
+        let b = t.see(key(1, 3), 1);
+        assert_ne!(a, b);
+        assert_eq!(t.see(key(1, 2), 2), a);
+        assert_eq!(t.unseen(2).collect::<Vec<_>>(), vec![(key(1, 3), false)]);
+        assert!(t.remove(&key(1, 3)).is_some());
+        assert!(t.get(&key(1, 3)).is_none() && t.at(b).is_none());
+        assert_eq!(t.len(), 1);
+        // The freed slot is the next pair's.
+        assert_eq!(t.see(key(2, 3), 3), b);
+        assert_eq!(t.iter().count(), 2);
+        assert!(
+            t.iter_seen()
+                .any(|(k, _, seen)| *k == key(2, 3) && seen == 3)
+        );
+    }
+}
