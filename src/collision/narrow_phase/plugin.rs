@@ -115,6 +115,9 @@ fn guarded<T>(failed: &mut bool, f: impl FnOnce() -> T) -> Option<T> {
     r
 }
 
+/// How often (steps) the pair table is put back in the broad phase's order.
+const REORDER_EVERY: u64 = 16;
+
 /// The narrow phase's reused buffers: the bodies of the step's pairs, the pairs' slots
 /// among them, and the point list of the point choice.
 type NarrowBuffers = (Wanted, Vec<(u32, u32)>, Vec<(Vec3A, f32, bool)>);
@@ -289,6 +292,19 @@ pub(crate) fn update_contacts(
         contacts.pairs.remove(&(a, b));
         if touching {
             ended.write(ContactEnded { a, b });
+        }
+    }
+    if step % REORDER_EVERY == 0 {
+        // Only when the pairs are out of order: a resting scene keeps the order it was
+        // found in, and copying its manifolds would only cost.
+        let contacts = &mut *contacts;
+        let jumps = contacts
+            .active
+            .windows(2)
+            .filter(|w| w[1] != w[0].wrapping_add(1))
+            .count();
+        if 4 * jumps > contacts.active.len() {
+            contacts.pairs.reorder(&mut contacts.active);
         }
     }
 }
