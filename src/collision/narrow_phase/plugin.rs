@@ -294,7 +294,7 @@ pub(crate) fn update_contacts(
             ended.write(ContactEnded { a, b });
         }
     }
-    if step % REORDER_EVERY == 0 {
+    if step.is_multiple_of(REORDER_EVERY) {
         // Only when the pairs are out of order: a resting scene keeps the order it was
         // found in, and copying its manifolds would only cost.
         let contacts = &mut *contacts;
