@@ -19,6 +19,7 @@ mod rapier_box3d;
 #[path = "../common/rapier_boxes.rs"]
 mod rapier_boxes;
 mod rigid;
+mod scaling;
 mod scenario;
 mod snapshot;
 mod soft;
@@ -388,7 +389,7 @@ fn main() {
         "{:<48} {:>14} {:>14} {:>7}  note",
         "name", "ours_ns", "reference_ns", "ratio"
     );
-    // `--only particles|rigid|contacts|box3d|springs|scenario|snapshot|soft|bevy|dial` runs one group (bevy with `--features bevy`).
+    // `--only particles|rigid|contacts|box3d|scaling|springs|scenario|snapshot|soft|bevy|dial` runs one group (bevy with `--features bevy`).
     let only = std::env::args()
         .skip_while(|a| a != "--only")
         .nth(1)
@@ -410,6 +411,9 @@ fn main() {
     }
     if run("box3d") {
         box3d::box3d_suite(quick);
+    }
+    if run("scaling") {
+        scaling::scaling_lines(&cfg, quick);
     }
     if run("springs") {
         springs::implicit_springs(&cfg);
