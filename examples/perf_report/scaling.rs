@@ -53,11 +53,7 @@ fn scaling_line(cfg: &Config, name: &str, n: usize, build: fn(usize) -> World, s
 /// The heap (goal: exponent ≤ 1.15) and the particles (≤ 1.05), at `PhysicsPlugins`'
 /// defaults (the particles without the energy pass, as every particle line).
 pub fn scaling_lines(cfg: &Config, quick: bool) {
-    let heaps: &[usize] = if quick {
-        &[10_000]
-    } else {
-        &[10_000, 100_000]
-    };
+    let heaps: &[usize] = if quick { &[10_000] } else { &[10_000, 100_000] };
     for &n in heaps {
         scaling_line(cfg, "heap", n, heap, SETTLE_STEPS);
     }
