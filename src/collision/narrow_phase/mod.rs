@@ -221,15 +221,26 @@ impl PairState {
 #[derive(Resource, Default)]
 pub struct Contacts {
     pub(crate) pairs: PairTable,
-    /// The slots of the pairs the narrow phase went through this step, in the broad
-    /// phase's order: the solver's preparation takes them from here.
-    pub(crate) active: Vec<u32>,
+    /// The pairs the narrow phase found points for this step (sensors left out), in the
+    /// broad phase's order: the solver's preparation takes them from here.
+    pub(crate) active: Vec<ActivePair>,
     pub(crate) step: u64,
     /// Touching pairs inside islands woken this step: the broad phase skipped them while
     /// they slept, but their manifolds still hold (nothing moved).
     pub(crate) woken: Vec<(Entity, Entity)>,
     /// Pairs whose manifolds parry computed again in the last step (the others were reused).
     pub(crate) updated: usize,
+}
+
+/// A pair with points to solve, as the narrow phase hands it to the solver.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ActivePair {
+    /// Its slot in the pair table.
+    pub slot: u32,
+    /// Its lower entity.
+    pub a: Entity,
+    /// Its higher entity.
+    pub b: Entity,
 }
 
 /// A touching pair, as reported by [`Contacts`].

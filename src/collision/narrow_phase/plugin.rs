@@ -10,7 +10,7 @@ use crate::collision::ContactFilter;
 use crate::collision::broad_phase::BroadPhase;
 use crate::collision::narrow_phase::fetch::Wanted;
 use crate::collision::narrow_phase::points::{PointsKey, choose_changed_points};
-use crate::collision::narrow_phase::{Contacts, Recycle};
+use crate::collision::narrow_phase::{ActivePair, Contacts, Recycle};
 use crate::collision::{Collider, ContactEnded, ContactSettings, ContactStarted, Sensor};
 use crate::collision::{radius, shape_pose};
 use crate::core::rest::Sleeping;
@@ -166,7 +166,6 @@ pub(crate) fn update_contacts(
         let (pose_a, pose_b) = (&ca.pose, &cb.pose);
         let sensor = ca.sensor || cb.sensor;
         let slot = contacts.pairs.see((a, b), step);
-        contacts.active.push(slot);
         let Some(state) = contacts.pairs.at_mut(slot) else {
             continue;
         };
@@ -278,6 +277,10 @@ pub(crate) fn update_contacts(
                 ended.write(ContactEnded { a, b });
             }
         }
+        // The solver takes the pairs with points, by slot, without reading them again.
+        if !sensor && state.solved().any(|m| !m.points.is_empty()) {
+            contacts.active.push(ActivePair { slot, a, b });
+        }
     }
     contacts.updated = updated;
     let mut gone: Vec<_> = contacts
@@ -301,10 +304,12 @@ pub(crate) fn update_contacts(
         let jumps = contacts
             .active
             .windows(2)
-            .filter(|w| w[1] != w[0].wrapping_add(1))
+            .filter(|w| w[1].slot != w[0].slot.wrapping_add(1))
             .count();
         if 4 * jumps > contacts.active.len() {
-            contacts.pairs.reorder(&mut contacts.active);
+            contacts
+                .pairs
+                .reorder(contacts.active.iter_mut().map(|p| &mut p.slot));
         }
     }
 }

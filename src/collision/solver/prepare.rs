@@ -8,7 +8,7 @@ use parry3d::math::Pose;
 use crate::collision::ContactFilter;
 use crate::collision::narrow_phase::fetch::Wanted;
 use crate::collision::narrow_phase::points::MAX_POINTS;
-use crate::collision::narrow_phase::{Contacts, FrozenGeometry};
+use crate::collision::narrow_phase::{ActivePair, Contacts, FrozenGeometry};
 use crate::collision::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, SolverBody};
 use crate::collision::{Collider, ContactSettings, Friction, Restitution, RestitutionThreshold};
 use crate::collision::{part_pose, shape_pose};
@@ -281,15 +281,20 @@ pub(crate) fn prepare_contacts(
     pairs.clear();
     // The pairs the narrow phase went through (in the broad phase's order, by slot), then
     // those of islands woken this step.
-    let woken = contacts.woken.iter().filter_map(|k| contacts.pairs.slot(k));
-    for slot in contacts.active.iter().copied().chain(woken) {
-        let Some(((ea, eb), state)) = contacts.pairs.pair_at(slot) else {
+    for &ActivePair { slot, a, b } in &contacts.active {
+        pairs.push((slot, wanted.slot(a) as u32, wanted.slot(b) as u32));
+    }
+    for &(a, b) in &contacts.woken {
+        let Some(slot) = contacts.pairs.slot(&(a, b)) else {
+            continue;
+        };
+        let Some(state) = contacts.pairs.at(slot) else {
             continue;
         };
         if state.sensor || state.solved().all(|m| m.points.is_empty()) {
             continue;
         }
-        pairs.push((slot, wanted.slot(ea) as u32, wanted.slot(eb) as u32));
+        pairs.push((slot, wanted.slot(a) as u32, wanted.slot(b) as u32));
     }
     sides.clear();
     sides.resize_with(wanted.len(), || None);
