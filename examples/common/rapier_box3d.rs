@@ -52,6 +52,27 @@ pub fn rapier_scene(
                 put(&mut world, hull.clone(), at, false);
             }
         }
+        SceneBodies::Washer(washer) => {
+            let g = washer.ground;
+            let c = rp::ColliderBuilder::cuboid(g.half.x, g.half.y, g.half.z);
+            put(&mut world, c, g.position, true);
+            let drum = world.insert_body(
+                rp::RigidBodyBuilder::kinematic_velocity_based()
+                    .translation(washer.centre)
+                    .linvel(washer.velocity)
+                    .angvel(washer.spin),
+            );
+            for part in &washer.parts {
+                let c = rp::ColliderBuilder::convex_hull(part)
+                    .expect("a valid hull")
+                    .friction(FRICTION);
+                world.insert_collider(c, Some(drum));
+            }
+            let h = washer.cube_half;
+            for &at in &washer.cubes {
+                put(&mut world, rp::ColliderBuilder::cuboid(h, h, h), at, false);
+            }
+        }
     }
     (world, handles)
 }

@@ -16,9 +16,9 @@ use crate::collision::{Collider, ColliderDensity, Friction};
 use crate::core::error::Result;
 use crate::core::time::PhysicsTime;
 use crate::particles::Gravity;
-use crate::particles::Position;
+use crate::particles::{LinearVelocity, Position};
 use crate::plugins::{PhysicsPlugins, PhysicsWorldExt};
-use crate::rigid::RigidBody;
+use crate::rigid::{AngularVelocity, RigidBody};
 use crate::sleep::SleepSettings;
 use crate::tools::scenes::BoxSpec;
 
@@ -38,11 +38,19 @@ pub enum Scene {
     /// sphere of radius 2 m (density 1000 kg/m³), dropped in a grid that collapses into a
     /// pile; 500 steps.
     ConvexPile,
+    /// `washer`: 20 × 20 × 20 = 8,000 cubes of 0.4 m (density 1000 kg/m³) tumbling in a
+    /// kinematic drum of 40 hulls turning at 25°/s about z; 1,000 steps.
+    Washer,
 }
 
 impl Scene {
     /// The suite, in Box3D's order.
-    pub const ALL: [Scene; 3] = [Scene::ConvexPile, Scene::LargePyramid, Scene::ManyPyramids];
+    pub const ALL: [Scene; 4] = [
+        Scene::ConvexPile,
+        Scene::LargePyramid,
+        Scene::ManyPyramids,
+        Scene::Washer,
+    ];
 
     /// Box3D's name for it.
     #[must_use]
@@ -51,6 +59,7 @@ impl Scene {
             Scene::LargePyramid => "large_pyramid",
             Scene::ManyPyramids => "many_pyramids",
             Scene::ConvexPile => "convex_pile",
+            Scene::Washer => "washer",
         }
     }
 
@@ -61,17 +70,18 @@ impl Scene {
             Scene::LargePyramid => 200,
             Scene::ManyPyramids => 100,
             Scene::ConvexPile => 500,
+            Scene::Washer => 1000,
         }
     }
 
     /// Whether bodies may sleep (Box3D turns sleeping off for the pyramids).
     #[must_use]
     pub fn sleeping(self) -> bool {
-        matches!(self, Scene::ConvexPile)
+        matches!(self, Scene::ConvexPile | Scene::Washer)
     }
 
     /// The scene's size: Box3D's full size, or its `BENCHMARK_DEBUG` size (a pyramid of base
-    /// 20, 3 × 3 pyramids, 10 layers of hulls) when `small`.
+    /// 20, 3 × 3 pyramids, 10 layers of hulls, 8 × 8 × 8 cubes in the drum) when `small`.
     #[must_use]
     pub fn bodies(self, small: bool) -> SceneBodies {
         match (self, small) {
@@ -81,6 +91,8 @@ impl Scene {
             (Scene::ManyPyramids, true) => SceneBodies::Boxes(many_pyramids(3, 3, 10)),
             (Scene::ConvexPile, false) => SceneBodies::Hulls(convex_pile(80)),
             (Scene::ConvexPile, true) => SceneBodies::Hulls(convex_pile(10)),
+            (Scene::Washer, false) => SceneBodies::Washer(washer(20)),
+            (Scene::Washer, true) => SceneBodies::Washer(washer(8)),
         }
     }
 
@@ -89,7 +101,7 @@ impl Scene {
     pub fn density(self) -> f32 {
         match self {
             Scene::LargePyramid | Scene::ManyPyramids => 100.0,
-            Scene::ConvexPile => 1000.0,
+            Scene::ConvexPile | Scene::Washer => 1000.0,
         }
     }
 }
@@ -101,6 +113,27 @@ pub enum SceneBodies {
     Boxes(Vec<BoxSpec>),
     /// A static ground box and copies of one convex hull.
     Hulls(HullPile),
+    /// A static ground, a turning kinematic drum and cubes inside it.
+    Washer(WasherSpec),
+}
+
+/// The washer: a ground, a drum of hulls and the cubes tumbling in it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct WasherSpec {
+    /// The static ground.
+    pub ground: BoxSpec,
+    /// The drum's centre at the start (m).
+    pub centre: Vec3,
+    /// The drum's velocity (m/s): Box3D gives it a slight drift.
+    pub velocity: Vec3,
+    /// The drum's angular velocity (rad/s).
+    pub spin: Vec3,
+    /// The drum's parts, each a hull's points in the drum's frame (m).
+    pub parts: Vec<Vec<Vec3>>,
+    /// The cubes' half side (m).
+    pub cube_half: f32,
+    /// The cubes' starting centres (m).
+    pub cubes: Vec<Vec3>,
 }
 
 /// The convex pile: a ground box, one hull's points and where its copies start.
@@ -223,6 +256,64 @@ fn convex_pile(layers: usize) -> HullPile {
     }
 }
 
+/// `CreateWasher`: a drum of 36 rim segments between radii 16 and 18 m (each spanning 10°
+/// and a tenth of that more on both sides, so they overlap) and 4 paddles between 14 and
+/// 16 m every 90°, all 20 m deep along z, centred at (0, 21, 0) and turning at 25°/s about z;
+/// `grid`³ cubes of 0.4 m, 0.8 m apart, inside it; a ground 120 m × 120 m, top at y = 0.
+#[must_use]
+fn washer(grid: usize) -> WasherSpec {
+    let (r0, r1, r2) = (14.0f32, 16.0f32, 18.0f32);
+    let (back, front) = (Vec3::new(0.0, 0.0, -10.0), Vec3::new(0.0, 0.0, 10.0));
+    let angle = std::f32::consts::PI / 18.0;
+    let turn = Quat::from_rotation_z(angle);
+    let overlap = Quat::from_rotation_z(0.1 * angle);
+    let slab = |inner: f32, outer: f32, a: Vec3, b: Vec3| {
+        vec![
+            back + inner * a,
+            back + outer * a,
+            back + inner * b,
+            back + outer * b,
+            front + inner * a,
+            front + outer * a,
+            front + inner * b,
+            front + outer * b,
+        ]
+    };
+    let mut parts = Vec::new();
+    let mut u1 = Vec3::X;
+    for i in 0..36 {
+        let u2 = if i == 35 { Vec3::X } else { turn * u1 };
+        parts.push(slab(r1, r2, overlap.inverse() * u1, overlap * u2));
+        if i % 9 == 0 {
+            parts.push(slab(r0, r1, u1, u2));
+        }
+        u1 = u2;
+    }
+    let a = 0.2f32;
+    let start = -2.0 * a * grid as f32;
+    let mut cubes = Vec::with_capacity(grid * grid * grid);
+    for i in 0..grid {
+        for j in 0..grid {
+            for k in 0..grid {
+                cubes.push(Vec3::new(
+                    start + 4.0 * a * i as f32,
+                    start + 21.0 + 4.0 * a * j as f32,
+                    start + 4.0 * a * k as f32,
+                ));
+            }
+        }
+    }
+    WasherSpec {
+        ground: ground(60.0, 60.0),
+        centre: Vec3::new(0.0, 21.0, 0.0),
+        velocity: Vec3::new(0.001, -0.002, 0.0),
+        spin: Vec3::new(0.0, 0.0, 25.0f32.to_radians()),
+        parts,
+        cube_half: a,
+        cubes,
+    }
+}
+
 /// A world set as Box3D's benchmark sets its own, at hooke's defaults otherwise:
 /// [`PhysicsPlugins`], 1/60 s with 4 substeps, gravity −10 m/s², sleeping as the scene says.
 ///
@@ -290,6 +381,34 @@ pub fn spawn(world: &mut World, bodies: &SceneBodies, density: f32) -> Result<Ve
                 put(world, hull.clone(), at, false);
             }
         }
+        SceneBodies::Washer(washer) => {
+            crate::tools::scenes::check_boxes(Some(washer.cubes.len()))?;
+            let g = washer.ground;
+            put(
+                world,
+                Collider::cuboid(g.half.x, g.half.y, g.half.z)?,
+                g.position,
+                true,
+            );
+            let parts = washer
+                .parts
+                .iter()
+                .map(|p| Ok((Vec3::ZERO, Quat::IDENTITY, Collider::convex_hull(p)?)))
+                .collect::<Result<Vec<_>>>()?;
+            world.spawn((
+                RigidBody::Kinematic,
+                Collider::compound(parts)?,
+                Position::from(washer.centre),
+                LinearVelocity::from(washer.velocity),
+                AngularVelocity::from(washer.spin),
+                Friction(FRICTION),
+            ));
+            let h = washer.cube_half;
+            let cube = Collider::cuboid(h, h, h)?;
+            for &at in &washer.cubes {
+                put(world, cube.clone(), at, false);
+            }
+        }
     }
     Ok(out)
 }
@@ -314,10 +433,38 @@ mod tests {
         let count = |s: Scene| match s.bodies(false) {
             SceneBodies::Boxes(b) => b.len() - 1,
             SceneBodies::Hulls(h) => h.positions.len(),
+            SceneBodies::Washer(w) => w.cubes.len(),
         };
         assert_eq!(count(Scene::LargePyramid), 5050);
         assert_eq!(count(Scene::ManyPyramids), 10_780);
         assert_eq!(count(Scene::ConvexPile), 5120);
+        assert_eq!(count(Scene::Washer), 8000);
+    }
+
+    #[test]
+    fn the_washer_drum_closes_and_holds_its_cubes() {
+        let w = washer(20);
+        assert_eq!(w.parts.len(), 40);
+        // The rim's segments overlap: each starts before the last one ended.
+        let angle = |p: &Vec3| p.y.atan2(p.x);
+        let ends: Vec<(f32, f32)> = w
+            .parts
+            .iter()
+            .filter(|p| (p[1].truncate().length() - 18.0).abs() < 1e-3)
+            .map(|p| (angle(&p[0]), angle(&p[2])))
+            .collect();
+        assert_eq!(ends.len(), 36);
+        for pair in ends.windows(2) {
+            let gap = (pair[1].0 - pair[0].1 + std::f32::consts::PI)
+                .rem_euclid(std::f32::consts::TAU)
+                - std::f32::consts::PI;
+            assert!(gap < 0.0, "{pair:?}");
+        }
+        // Every cube starts inside the paddles' radius and the drum's depth.
+        for c in &w.cubes {
+            let r = (c.truncate() - w.centre.truncate()).length() + w.cube_half * 2f32.sqrt();
+            assert!(r < 14.0 && c.z.abs() + w.cube_half < 10.0, "{c}");
+        }
     }
 
     #[test]
