@@ -359,23 +359,12 @@ pub fn spawn(world: &mut World, bodies: &SceneBodies, density: f32) -> Result<Ve
         SceneBodies::Boxes(specs) => {
             crate::tools::scenes::check_boxes(Some(specs.len()))?;
             for b in specs {
-                put(
-                    world,
-                    Collider::cuboid(b.half.x, b.half.y, b.half.z)?,
-                    b.position,
-                    b.fixed,
-                );
+                put(world, cuboid(b)?, b.position, b.fixed);
             }
         }
         SceneBodies::Hulls(pile) => {
             crate::tools::scenes::check_boxes(Some(pile.positions.len()))?;
-            let g = pile.ground;
-            put(
-                world,
-                Collider::cuboid(g.half.x, g.half.y, g.half.z)?,
-                g.position,
-                true,
-            );
+            put(world, cuboid(&pile.ground)?, pile.ground.position, true);
             let hull = Collider::convex_hull(&pile.points)?;
             for &at in &pile.positions {
                 put(world, hull.clone(), at, false);
@@ -383,13 +372,7 @@ pub fn spawn(world: &mut World, bodies: &SceneBodies, density: f32) -> Result<Ve
         }
         SceneBodies::Washer(washer) => {
             crate::tools::scenes::check_boxes(Some(washer.cubes.len()))?;
-            let g = washer.ground;
-            put(
-                world,
-                Collider::cuboid(g.half.x, g.half.y, g.half.z)?,
-                g.position,
-                true,
-            );
+            put(world, cuboid(&washer.ground)?, washer.ground.position, true);
             let parts = washer
                 .parts
                 .iter()
@@ -411,6 +394,11 @@ pub fn spawn(world: &mut World, bodies: &SceneBodies, density: f32) -> Result<Ve
         }
     }
     Ok(out)
+}
+
+/// The collider of a box spec (its orientation is the body's).
+fn cuboid(b: &BoxSpec) -> Result<Collider> {
+    Collider::cuboid(b.half.x, b.half.y, b.half.z)
 }
 
 /// A world holding `scene` at its full size (or Box3D's debug size when `small`), ready for
