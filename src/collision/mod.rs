@@ -65,6 +65,7 @@ pub(crate) mod narrow_phase;
 pub(crate) mod nodes;
 mod plugin;
 mod query;
+pub(crate) mod radii;
 pub(crate) mod slots;
 pub(crate) mod solver;
 
@@ -93,7 +94,8 @@ pub(crate) fn shape_pose(x: Vec3A, q: Quat, com: Option<&CenterOfMass>) -> Pose 
 pub(crate) fn radius(collider: &Collider, com: Option<&CenterOfMass>) -> f32 {
     let [min, max] = collider.local_bounds();
     let c = com.map_or(Vec3::ZERO, |c| c.0);
-    (min - c).length().max((max - c).length())
+    let corners = (min - c).length().max((max - c).length());
+    corners.min(collider.radii.0 + c.length())
 }
 
 /// The bodies the contact systems see: not quarantined, and not a part of another body (its
@@ -160,6 +162,9 @@ pub struct Collider {
     shape: SharedShape,
     /// The shape's local bounding box, kept: the contact systems read it every step.
     bounds: [Vec3; 2],
+    /// The farthest point from the shape's origin and the largest ball about the origin
+    /// inside the shape (m; see [`radii::radii`]), kept for the same reason.
+    radii: (f32, f32),
     /// Built by hooke from a body's parts (see the `attach` module), not by the user.
     composed: bool,
 }
@@ -353,9 +358,11 @@ impl Collider {
                 range: "bounds with a positive size",
             });
         }
+        let bounds = [aabb.mins, aabb.maxs];
         Ok(Self {
+            radii: radii::radii(&*shape, bounds),
             shape,
-            bounds: [aabb.mins, aabb.maxs],
+            bounds,
             composed: false,
         })
     }
@@ -364,6 +371,12 @@ impl Collider {
     #[must_use]
     pub(crate) fn local_bounds(&self) -> [Vec3; 2] {
         self.bounds
+    }
+
+    /// The largest ball about the shape's origin inside it (m; 0 where not known).
+    #[must_use]
+    pub(crate) fn inner_radius(&self) -> f32 {
+        self.radii.1
     }
 
     /// A ball of radius `r` (m).

@@ -194,7 +194,11 @@ impl Recycle {
         let turn = self.pos12.rotation.inverse() * pos12.rotation;
         let drift = (pos12.translation - self.pos12.translation).length()
             + 2.0 * turn.xyz().length() * extent;
-        drift <= window && drift + prediction <= self.reach
+        // A reach far past today's prediction (a fast pair that slowed, or two hulls now
+        // moving together) kept speculative points that can no longer close: shed them.
+        drift <= window
+            && drift + prediction <= self.reach
+            && self.reach <= 2.0 * (prediction + window)
     }
 }
 

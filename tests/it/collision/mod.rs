@@ -11,6 +11,7 @@ mod energy_in_any_order;
 mod every_integrator_keeps_resting_contact;
 mod fast_meshes_do_not_tunnel;
 mod fast_spin_stays_above_ground;
+mod hull_prediction_follows_the_gap;
 mod landing_stays_in_place;
 mod mesh_contacts;
 mod meshes_leave_deep_overlap_at_a_bounded_speed;

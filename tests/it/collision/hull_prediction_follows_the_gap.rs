@@ -1,0 +1,104 @@
+//! Guards the prediction distance between two hulls, which counts each hull's speed toward
+//! the other along their separating axis (issue 38). Box3D's convex pile drops hulls side
+//! by side; counting each one's whole speed gave neighbours falling together speculative
+//! points between them that could never close, three times rapier's points. The axis must
+//! still see a hull that lands while another falls onto it.
+
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use hooke::collision::Contacts;
+use hooke::prelude::*;
+
+/// 32 points spread over a sphere of radius 2 (a Fibonacci lattice), the size of Box3D's
+/// pile hulls.
+fn hull_points() -> Vec<Vec3> {
+    let n = 32;
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    (0..n)
+        .map(|i| {
+            let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let r = (1.0 - y * y).sqrt();
+            let t = golden * i as f32;
+            2.0 * Vec3::new(r * t.cos(), y, r * t.sin())
+        })
+        .collect()
+}
+
+/// The hull's extent along `axis`, below and above its origin (m).
+fn extent(axis: Vec3) -> (f32, f32) {
+    let d = hull_points()
+        .iter()
+        .map(|p| p.dot(axis))
+        .collect::<Vec<_>>();
+    (
+        -d.iter().copied().fold(f32::INFINITY, f32::min),
+        d.iter().copied().fold(f32::NEG_INFINITY, f32::max),
+    )
+}
+
+fn hull(w: &mut World, at: Vec3, v: Vec3) -> Entity {
+    w.spawn((
+        RigidBody::Dynamic,
+        Collider::convex_hull(&hull_points()).unwrap(),
+        Position::from(at),
+        LinearVelocity::from(v),
+    ))
+    .id()
+}
+
+#[test]
+fn hulls_falling_side_by_side_keep_no_points_between_them() {
+    let mut w = World::new();
+    w.add_physics(PhysicsPlugins);
+    // 3 cm apart along x: inside the boxes' margins, so the two are a pair, but they fall
+    // together at 50 m/s and can never meet.
+    let (below, above) = extent(Vec3::X);
+    let a = hull(&mut w, Vec3::new(0.0, 500.0, 0.0), Vec3::NEG_Y * 50.0);
+    let b = hull(
+        &mut w,
+        Vec3::new(above + below + 0.03, 500.0, 0.0),
+        Vec3::NEG_Y * 50.0,
+    );
+    for _ in 0..10 {
+        w.step_physics();
+    }
+    let contacts = w.resource::<Contacts>();
+    assert_eq!(contacts.pairs_len(), 1, "the two are a pair");
+    assert_eq!(contacts.manifold_stats().1, 0, "no speculative points");
+    assert!(!contacts.are_touching(a, b));
+}
+
+#[test]
+fn a_hull_falling_onto_one_that_lands_stops_on_it() {
+    let mut w = World::new();
+    w.add_physics(PhysicsPlugins);
+    w.spawn((
+        RigidBody::Static,
+        Collider::cuboid(20.0, 0.5, 20.0).unwrap(),
+        Position::from(Vec3::new(0.0, -0.5, 0.0)),
+    ));
+    // Both fall at 30 m/s (half a metre a step), 3 cm apart, the lower one 1.6 m above
+    // the ground: it lands in the fourth step and the upper one must stop on it within the
+    // step, though the two moved together until then.
+    let (below, above) = extent(Vec3::Y);
+    let low = hull(&mut w, Vec3::new(0.0, below + 1.6, 0.0), Vec3::NEG_Y * 30.0);
+    let high = hull(
+        &mut w,
+        Vec3::new(0.0, below + 1.6 + above + below + 0.03, 0.0),
+        Vec3::NEG_Y * 30.0,
+    );
+    let (mut deepest, mut touched) = (0.0f32, false);
+    for _ in 0..30 {
+        w.step_physics();
+        if let Some(p) = w.resource::<Contacts>().pair(low, high) {
+            deepest = deepest.max(p.depth);
+            touched = true;
+        }
+    }
+    println!(
+        "the upper hull went {:.1} mm into the lower one",
+        deepest * 1e3
+    );
+    assert!(touched, "the upper hull landed on the lower one");
+    assert!(deepest < 0.05, "went {deepest} m into it");
+}
