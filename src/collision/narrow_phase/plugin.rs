@@ -83,6 +83,7 @@ impl<'a> NarrowBody<'a> {
             spin: self.spin,
             centre: self.centre,
             swing: self.swing,
+            reach: self.reach,
         }
     }
 }
