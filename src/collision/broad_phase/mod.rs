@@ -6,7 +6,8 @@
 //!   coherent motion is close to O(n). The set is rebuilt (O(n log n)) only when colliders
 //!   are added or removed. The sort key is (cell, min along the sweep axis): cells are
 //!   slabs across a second axis, twice as thick as the largest box is along it, so a box
-//!   can only overlap boxes of its own slab or the next. Sweeping slab by slab keeps a
+//!   can only overlap boxes of its own slab or the next. A few boxes far thicker than the
+//!   rest (a container around its contents) are set apart and tested against every box. Sweeping slab by slab keeps a
 //!   regular grid of boxes (a 10×10×10 stack) from testing every box of a whole row.
 //!   The boxes are held grown a little (see the collision plugin's `run_broad_phase`), and
 //!   while none of them changed the last pairs still hold and the sweep does not run.
@@ -191,14 +192,39 @@ pub(crate) fn sweep_axes(entries: &[Entry]) -> [usize; 2] {
     [axes[0], axes[1]]
 }
 
+/// The slab of a box far thicker than the others (see [`assign_cells`]).
+const BIG: i32 = i32::MIN;
+
 /// Sets every entry's slab across `axis`: slabs twice as thick as the thickest box, so two
 /// overlapping boxes are at most one slab apart even after rounding. Returns the widest
 /// extent along `along` (the sweep axis). Far from the origin (more than a million slabs
 /// out) or with no extent, everything shares one slab.
+///
+/// A few boxes more than eight times the median thickness (Box3D's washer drum, 20 m
+/// around 8,000 cubes of 0.4 m) would make one slab of everything and a sweep in which each
+/// cube meets hundreds: they go to a slab of their own, [`BIG`], sorted first, and are
+/// tested against every box (a few times n). With many such boxes (more than n/32 + 8) the
+/// scene has no outliers and none is set apart.
 fn assign_cells(entries: &mut [Entry], axis: usize, along: usize) -> f32 {
+    let thickness = |e: &Entry| e.max[axis] - e.min[axis];
+    let mut sizes: Vec<f32> = entries.iter().map(thickness).collect();
+    let big = match sizes.len() {
+        0 => f32::INFINITY,
+        n => {
+            let median = *sizes.select_nth_unstable_by(n / 2, f32::total_cmp).1;
+            let cut = 8.0 * median;
+            let count = sizes.iter().filter(|&&t| t > cut).count();
+            if median > 0.0 && count <= n / 32 + 8 {
+                cut
+            } else {
+                f32::INFINITY
+            }
+        }
+    };
+    let is_big = |e: &Entry| thickness(e) > big;
     let (mut thick, mut wide) = (0.0f32, 0.0f32);
-    for e in entries.iter() {
-        thick = thick.max(e.max[axis] - e.min[axis]);
+    for e in entries.iter().filter(|e| !is_big(e)) {
+        thick = thick.max(thickness(e));
         wide = wide.max(e.max[along] - e.min[along]);
     }
     let size = 2.0 * thick;
@@ -207,10 +233,18 @@ fn assign_cells(entries: &mut [Entry], axis: usize, along: usize) -> f32 {
     for e in entries.iter_mut() {
         let slab = e.min[axis] / size;
         far |= !slab.is_finite() || slab.abs() > 1e6;
-        e.cell = slab.floor() as i32;
+        e.cell = if thickness(e) > big {
+            BIG
+        } else {
+            slab.floor() as i32
+        };
     }
     if far {
         entries.iter_mut().for_each(|e| e.cell = 0);
+        wide = entries
+            .iter()
+            .map(|e| e.max[along] - e.min[along])
+            .fold(0.0, f32::max);
     }
     wide
 }
@@ -314,6 +348,16 @@ impl BroadPhase {
                 from += 1;
             }
             self.sweep_run(i, from, after, hi);
+        }
+        // The boxes set apart as far thicker than the rest, against every other box.
+        let big = self.moving.iter().take_while(|e| e.cell == BIG).count();
+        for a in &self.moving[..big] {
+            for b in &self.moving[big..] {
+                let overlap = a.min.cmple(b.max).all() && b.min.cmple(a.max).all();
+                if overlap && (a.awake || b.awake) && a.layers.interacts(b.layers) {
+                    self.found.push(key(a.entity, b.entity));
+                }
+            }
         }
         self.refresh_fixed();
         for a in self.moving.iter().filter(|a| a.awake) {
@@ -514,11 +558,19 @@ mod tests {
 
     #[test]
     fn slab_sweep_finds_exactly_the_brute_force_pairs_as_boxes_move() {
-        for (seed, spread) in [(1, 12.0), (2, 30.0), (3, 4.0)] {
+        for (seed, spread) in [(1, 12.0), (2, 30.0), (3, 4.0), (4, 12.0)] {
             let mut moving = scatter(400, seed, spread);
             // One long box across everything: thick slabs, every pair still found.
             if seed == 2 {
                 moving[5].max.z += 20.0;
+            }
+            // Three containers around everything: set apart from the sweep, each tested
+            // against every box.
+            if seed == 4 {
+                for k in [5, 9, 13] {
+                    moving[k].min -= Vec3::splat(20.0);
+                    moving[k].max += Vec3::splat(20.0);
+                }
             }
             let mut bp = BroadPhase {
                 moving: moving.clone(),
@@ -527,6 +579,8 @@ mod tests {
             bp.refresh_fixed();
             bp.find_pairs();
             assert_eq!(bp.pairs, brute_force(&moving), "seed {seed}");
+            let apart = bp.moving.iter().filter(|e| e.cell == BIG).count();
+            assert_eq!(apart, if seed == 4 { 3 } else { 0 }, "seed {seed}");
             // Move every box a little (incremental re-sort) and a few a lot.
             for step in 0..3u32 {
                 for (k, e) in bp.moving.iter_mut().enumerate() {
