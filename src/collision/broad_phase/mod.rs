@@ -6,9 +6,10 @@
 //!   coherent motion is close to O(n). The set is rebuilt (O(n log n)) only when colliders
 //!   are added or removed. The sort key is (cell, min along the sweep axis): cells are
 //!   slabs across a second axis, twice as thick as the largest box is along it, so a box
-//!   can only overlap boxes of its own slab or the next. A few boxes far thicker than the
-//!   rest (a container around its contents) are set apart and tested against every box. Sweeping slab by slab keeps a
-//!   regular grid of boxes (a 10×10×10 stack) from testing every box of a whole row.
+//!   can only overlap boxes of its own slab or the next. Sweeping slab by slab keeps a
+//!   regular grid of boxes (a 10×10×10 stack) from testing every box of a whole row. A few
+//!   boxes far thicker than the rest (a container around its contents) are set apart and
+//!   tested against every box.
 //!   The boxes are held grown a little (see the collision plugin's `run_broad_phase`), and
 //!   while none of them changed the last pairs still hold and the sweep does not run.
 //! - **Fixed** colliders sit in parry's BVH, rebuilt only when one of them is added, moved,
@@ -67,6 +68,8 @@ pub(crate) struct BroadPhase {
     /// The moving boxes in sweep order as six coordinate arrays, padded with empty boxes to
     /// whole lanes: the sweep tests four candidates at once.
     sweep: Sweep,
+    /// The boxes' thicknesses across the slabs, reused each step to find their median.
+    sizes: Vec<f32>,
 }
 
 /// Structure-of-arrays copy of the sorted moving boxes.
@@ -126,6 +129,7 @@ impl Default for BroadPhase {
             found_before: Vec::new(),
             pairs_from_found: false,
             sweep: Sweep::default(),
+            sizes: Vec::new(),
         }
     }
 }
@@ -205,9 +209,10 @@ const BIG: i32 = i32::MIN;
 /// cube meets hundreds: they go to a slab of their own, [`BIG`], sorted first, and are
 /// tested against every box (a few times n). With many such boxes (more than n/32 + 8) the
 /// scene has no outliers and none is set apart.
-fn assign_cells(entries: &mut [Entry], axis: usize, along: usize) -> f32 {
+fn assign_cells(entries: &mut [Entry], sizes: &mut Vec<f32>, axis: usize, along: usize) -> f32 {
     let thickness = |e: &Entry| e.max[axis] - e.min[axis];
-    let mut sizes: Vec<f32> = entries.iter().map(thickness).collect();
+    sizes.clear();
+    sizes.extend(entries.iter().map(thickness));
     let big = match sizes.len() {
         0 => f32::INFINITY,
         n => {
@@ -233,11 +238,7 @@ fn assign_cells(entries: &mut [Entry], axis: usize, along: usize) -> f32 {
     for e in entries.iter_mut() {
         let slab = e.min[axis] / size;
         far |= !slab.is_finite() || slab.abs() > 1e6;
-        e.cell = if thickness(e) > big {
-            BIG
-        } else {
-            slab.floor() as i32
-        };
+        e.cell = if is_big(e) { BIG } else { slab.floor() as i32 };
     }
     if far {
         entries.iter_mut().for_each(|e| e.cell = 0);
@@ -299,7 +300,7 @@ impl BroadPhase {
             [self.axis, self.cell_axis] = sweep_axes(&self.moving);
         }
         let axis = self.axis;
-        let wide = assign_cells(&mut self.moving, self.cell_axis, axis);
+        let wide = assign_cells(&mut self.moving, &mut self.sizes, self.cell_axis, axis);
         if self.moving_dirty {
             self.moving.sort_unstable_by(|a, b| sweep_order(a, b, axis));
             self.moving_dirty = false;

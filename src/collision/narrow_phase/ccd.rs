@@ -84,6 +84,17 @@ impl CastSide<'_> {
     }
 }
 
+/// Of a pair, whether `a` is the smaller side (by reach), and the larger side's velocity at
+/// the smaller side's centre of mass (m/s), its spin taken about its own centre.
+#[must_use]
+pub(crate) fn at_smaller(a: &CastSide, b: &CastSide) -> (bool, Vec3) {
+    let a_small = a.reach <= b.reach;
+    let (small, large) = if a_small { (a, b) } else { (b, a) };
+    let centre = |s: &CastSide| s.pose * s.centre;
+    let there = large.velocity + large.spin.cross(centre(small) - centre(large));
+    (a_small, there)
+}
+
 /// The speculative manifold of the first impact within `dt`, if the pair will hit and none
 /// of `manifolds` already has its normal; `thin` is the thinner side's thickness and
 /// `scratch` the point choice's buffer.
@@ -101,23 +112,16 @@ pub(crate) fn impact_manifold(
         stop_at_penetration: false,
         compute_impact_geometry_on_penetration: false,
     };
-    // A side whose spin sweeps more than the linear cast's tolerance is cast along its arc
-    // (conservative advancement, dearer), else along a line. The arc cast can fail (its
-    // bisection steps into an overlap and its normal is then meaningless: a box spinning at
-    // 500 rad/s was given one that spun it up to 1,500 rad/s); the line cast stands in. An
-    // unsupported pair (a trimesh against a trimesh) answers Err: no cast.
     // A larger side that barely turns in the step (Box3D's washer drum, 20 m across at
     // 25°/s: its arc leaves the tangent by r (ω dt)² / 2 = 0.3 mm) moves near the smaller
     // side as a translation at its velocity there. It is cast so, and the pair is judged by
     // the spin the two differ by over the smaller side's reach; casting the drum along its
     // arc against every cube in it took half the washer's step.
-    let a_small = a.reach <= b.reach;
+    let (a_small, there) = at_smaller(a, b);
     let (small, large) = if a_small { (a, b) } else { (b, a) };
     let turn = large.spin.length() * dt;
     let steady = 0.5 * large.reach * turn * turn <= 0.1 * thin;
     let (va, vb, sweep) = if steady {
-        let centre = |s: &CastSide| s.pose * s.centre;
-        let there = large.velocity + large.spin.cross(centre(small) - centre(large));
         let sweep = (a.spin - b.spin).length() * small.reach;
         match a_small {
             true => (a.velocity, there, sweep),
@@ -126,6 +130,11 @@ pub(crate) fn impact_manifold(
     } else {
         (a.velocity, b.velocity, a.swing.max(b.swing))
     };
+    // A side whose spin sweeps more than the linear cast's tolerance is cast along its arc
+    // (conservative advancement, dearer), else along a line. The arc cast can fail (its
+    // bisection steps into an overlap and its normal is then meaningless: a box spinning at
+    // 500 rad/s was given one that spun it up to 1,500 rad/s); the line cast stands in. An
+    // unsupported pair (a trimesh against a trimesh) answers Err: no cast.
     let linear = || {
         parry3d::query::cast_shapes(&a.pose, va, a.shape, &b.pose, vb, b.shape, options)
             .ok()

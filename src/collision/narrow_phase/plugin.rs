@@ -131,19 +131,20 @@ fn narrow_body<'a>(
 /// points at 9 m/s, and taking that as the pair's speed cast every cube in it every step,
 /// though the drum's wall near a cube moves with it.
 fn local_sweep(a: &NarrowBody, b: &NarrowBody) -> f32 {
-    let (small, large) = if a.reach <= b.reach { (a, b) } else { (b, a) };
-    let centre = |s: &NarrowBody| s.pose * s.centre;
-    let at_small = large.velocity + large.spin.cross(centre(small) - centre(large));
-    (small.velocity - at_small).length() + (small.spin - large.spin).length() * small.reach
+    let (sa, sb) = (a.cast_side(), b.cast_side());
+    let (a_small, there) = crate::collision::narrow_phase::ccd::at_smaller(&sa, &sb);
+    let small = if a_small { &sa } else { &sb };
+    (small.velocity - there).length() + (sa.spin - sb.spin).length() * small.reach
 }
 
 /// How fast the pair can close within the step (m/s), for the prediction distance.
 ///
 /// Each side may keep its velocity or be stopped by a third body mid-step, so the bound is
-/// each side's speed toward the other, summed, plus both spins' swing. "Toward" is along the
-/// separating axis of the last step (two hulls that were apart, see below): to touch, the
-/// two must close the gap along it. Without one it is each side's whole speed. The spin's part is how fast it can move the surface
-/// ([`crate::collision::radii::surface_swing`]), which for a ball about its centre is none.
+/// each side's speed toward the other, summed, plus how fast each one's spin moves its
+/// surface ([`crate::collision::radii::surface_swing`]; none for a ball about its centre).
+/// "Toward" is along the separating axis of the last step (two hulls that were apart, see
+/// below): to touch, the two must close the gap along it. Without one it is each side's
+/// whole speed.
 ///
 /// Why: Box3D's pile drops 5,120 hulls side by side. Counting the whole speed of each gave
 /// neighbours falling together a prediction of metres, and parry then found speculative
