@@ -70,35 +70,41 @@ fn hulls_falling_side_by_side_keep_no_points_between_them() {
 
 #[test]
 fn a_hull_falling_onto_one_that_lands_stops_on_it() {
-    let mut w = World::new();
-    w.add_physics(PhysicsPlugins);
-    w.spawn((
-        RigidBody::Static,
-        Collider::cuboid(20.0, 0.5, 20.0).unwrap(),
-        Position::from(Vec3::new(0.0, -0.5, 0.0)),
-    ));
-    // Both fall at 30 m/s (half a metre a step), 3 cm apart, the lower one 1.6 m above
-    // the ground: it lands in the fourth step and the upper one must stop on it within the
-    // step, though the two moved together until then.
-    let (below, above) = extent(Vec3::Y);
-    let low = hull(&mut w, Vec3::new(0.0, below + 1.6, 0.0), Vec3::NEG_Y * 30.0);
-    let high = hull(
-        &mut w,
-        Vec3::new(0.0, below + 1.6 + above + below + 0.03, 0.0),
-        Vec3::NEG_Y * 30.0,
-    );
-    let (mut deepest, mut touched) = (0.0f32, false);
-    for _ in 0..30 {
-        w.step_physics();
-        if let Some(p) = w.resource::<Contacts>().pair(low, high) {
-            deepest = deepest.max(p.depth);
-            touched = true;
+    // Either spawn order: the pair's first entity is then the lower or the upper hull.
+    for upper_first in [false, true] {
+        let mut w = World::new();
+        w.add_physics(PhysicsPlugins);
+        w.spawn((
+            RigidBody::Static,
+            Collider::cuboid(20.0, 0.5, 20.0).unwrap(),
+            Position::from(Vec3::new(0.0, -0.5, 0.0)),
+        ));
+        // Both fall at 30 m/s (half a metre a step), 3 cm apart, the lower one 1.6 m above
+        // the ground: it lands in the fourth step and the upper one must stop on it within
+        // the step, though the two moved together until then.
+        let (below, above) = extent(Vec3::Y);
+        let low_at = Vec3::new(0.0, below + 1.6, 0.0);
+        let high_at = low_at + Vec3::Y * (above + below + 0.03);
+        let (low, high) = if upper_first {
+            let high = hull(&mut w, high_at, Vec3::NEG_Y * 30.0);
+            (hull(&mut w, low_at, Vec3::NEG_Y * 30.0), high)
+        } else {
+            let low = hull(&mut w, low_at, Vec3::NEG_Y * 30.0);
+            (low, hull(&mut w, high_at, Vec3::NEG_Y * 30.0))
+        };
+        let (mut deepest, mut touched) = (0.0f32, false);
+        for _ in 0..30 {
+            w.step_physics();
+            if let Some(p) = w.resource::<Contacts>().pair(low, high) {
+                deepest = deepest.max(p.depth);
+                touched = true;
+            }
         }
+        println!(
+            "upper spawned first: {upper_first}; the upper hull went {:.1} mm into the lower one",
+            deepest * 1e3
+        );
+        assert!(touched, "the upper hull landed on the lower one");
+        assert!(deepest < 0.05, "went {deepest} m into it");
     }
-    println!(
-        "the upper hull went {:.1} mm into the lower one",
-        deepest * 1e3
-    );
-    assert!(touched, "the upper hull landed on the lower one");
-    assert!(deepest < 0.05, "went {deepest} m into it");
 }
