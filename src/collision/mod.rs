@@ -68,6 +68,7 @@ mod query;
 pub(crate) mod radii;
 pub(crate) mod slots;
 pub(crate) mod solver;
+pub(crate) mod support;
 
 pub(crate) use attach::OwnShape;
 pub use attach::{ColliderDensity, ColliderOf, ColliderOffset, MAX_PART_DEPTH};
@@ -165,6 +166,9 @@ pub struct Collider {
     /// The farthest point from the shape's origin and the largest ball about the origin
     /// inside the shape (m; see [`radii::radii`]), kept for the same reason.
     radii: (f32, f32),
+    /// A hull's vertices in columns for its support point (see [`support`]), shared by
+    /// the collider's clones like the shape.
+    lanes: Option<std::sync::Arc<support::HullLanes>>,
     /// Built by hooke from a body's parts (see the `attach` module), not by the user.
     composed: bool,
 }
@@ -361,6 +365,10 @@ impl Collider {
         let bounds = [aabb.mins, aabb.maxs];
         Ok(Self {
             radii: radii::radii(&*shape, bounds),
+            lanes: shape
+                .as_convex_polyhedron()
+                .and_then(support::HullLanes::new)
+                .map(std::sync::Arc::new),
             shape,
             bounds,
             composed: false,
@@ -371,6 +379,15 @@ impl Collider {
     #[must_use]
     pub(crate) fn local_bounds(&self) -> [Vec3; 2] {
         self.bounds
+    }
+
+    /// The shape as a hull with its vertices in columns, if it is a hull.
+    #[must_use]
+    pub(crate) fn laned_hull(&self) -> Option<support::LanedHull<'_>> {
+        Some(support::LanedHull {
+            hull: self.shape.as_convex_polyhedron()?,
+            lanes: self.lanes.as_deref()?,
+        })
     }
 
     /// The largest ball about the shape's origin inside it (m; 0 where not known).

@@ -10,7 +10,7 @@ use crate::collision::ContactFilter;
 use crate::collision::broad_phase::BroadPhase;
 use crate::collision::narrow_phase::fetch::Wanted;
 use crate::collision::narrow_phase::points::{PointsKey, choose_changed_points};
-use crate::collision::narrow_phase::{ActivePair, Contacts, Manifold, Recycle};
+use crate::collision::narrow_phase::{ActivePair, Contacts, Manifold, PairState, Recycle};
 use crate::collision::{Collider, ContactEnded, ContactSettings, ContactStarted, Sensor};
 use crate::collision::{radius, shape_pose};
 use crate::core::rest::Sleeping;
@@ -173,6 +173,43 @@ fn approach_speed(a: &NarrowBody, b: &NarrowBody, manifolds: &[Manifold]) -> f32
     }
 }
 
+/// parry's manifolds for a pair; two hulls go straight to parry's hull-against-hull
+/// manifold with their vertices in columns (see [`crate::collision::support`]), which is
+/// what parry's dispatcher calls for them, with a faster support point.
+fn contact_manifolds(
+    a: &Collider,
+    b: &Collider,
+    pos12: &Pose,
+    reach: f32,
+    state: &mut PairState,
+) -> Result<(), parry3d::query::Unsupported> {
+    if let (Some(ha), Some(hb)) = (a.laned_hull(), b.laned_hull()) {
+        if state.manifolds.is_empty() {
+            state.manifolds.push(Manifold::new());
+        }
+        parry3d::query::details::contact_manifold_pfm_pfm(
+            pos12,
+            &ha,
+            0.0,
+            None,
+            &hb,
+            0.0,
+            None,
+            reach,
+            &mut state.manifolds[0],
+        );
+        return Ok(());
+    }
+    DefaultQueryDispatcher.contact_manifolds(
+        pos12,
+        &**a.shape(),
+        &**b.shape(),
+        reach,
+        &mut state.manifolds,
+        &mut state.workspace,
+    )
+}
+
 /// Runs a parry call; a panic inside it sets `failed` and gives `None`.
 #[inline]
 fn guarded<T>(failed: &mut bool, f: impl FnOnce() -> T) -> Option<T> {
@@ -269,14 +306,7 @@ pub(crate) fn update_contacts(
                         let reach = prediction + window;
                         let before = PointsKey::of(&state.manifolds);
                         let result = guarded(&mut failed, || {
-                            DefaultQueryDispatcher.contact_manifolds(
-                                &pos12,
-                                &**ca.collider.shape(),
-                                &**cb.collider.shape(),
-                                reach,
-                                &mut state.manifolds,
-                                &mut state.workspace,
-                            )
+                            contact_manifolds(ca.collider, cb.collider, &pos12, reach, state)
                         })
                         .unwrap_or(Err(parry3d::query::Unsupported));
                         if result.is_err() {
