@@ -309,8 +309,21 @@ pub(crate) fn update_contacts(
                             contact_manifolds(ca.collider, cb.collider, &pos12, reach, state)
                         })
                         .unwrap_or(Err(parry3d::query::Unsupported));
+                        // Two shapes cannot overlap by more than the narrower one's width,
+                        // at most twice its reach. A deeper point is parry's GJK and EPA
+                        // failing on a degenerate simplex (Box3D's pile: a hull 5.5 m "into"
+                        // the ground along (−1, 1, −1)/√3), and pushing it out would kick the
+                        // body sideways at the push-out speed: the pair starts afresh.
+                        let deepest = 2.0 * ca.reach.min(cb.reach) + settings.margin;
+                        let impossible = (state.manifolds.iter().flat_map(|m| &m.points))
+                            .any(|p| p.dist < -deepest);
+                        let result = match impossible {
+                            true => Err(parry3d::query::Unsupported),
+                            false => result,
+                        };
                         if result.is_err() {
                             state.manifolds.clear();
+                            state.workspace = None;
                         }
                         // parry keeps a manifold's points while the pose holds still (two
                         // hulls falling together), whatever today's reach: past it they
