@@ -89,7 +89,7 @@ impl Columns {
 }
 
 /// A parry hull with its [`HullLanes`]: parry's own hull in every query but the support
-/// point.
+/// point and the support face, which come from the columns.
 #[derive(Clone, Copy)]
 pub(crate) struct LanedHull<'a> {
     /// The hull.
@@ -106,8 +106,8 @@ impl SupportMap for LanedHull<'_> {
 }
 
 impl PolygonalFeatureMap for LanedHull<'_> {
-    #[inline]
     /// parry's hull feature: the leading face's first four vertices and edges.
+    #[inline]
     fn local_support_feature(&self, dir: Vec3, out_feature: &mut PolygonalFeature) {
         let fid = self.lanes.normals.support_id(dir);
         let face = &self.hull.faces()[fid];
