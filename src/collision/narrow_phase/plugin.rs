@@ -151,16 +151,17 @@ fn local_sweep(a: &NarrowBody, b: &NarrowBody) -> f32 {
 /// points between every pair of them, three times rapier's points, that could never close.
 /// A hull above another that lands still sees the full speed along their normal.
 fn approach_speed(a: &NarrowBody, b: &NarrowBody, manifolds: &[Manifold]) -> f32 {
-    let (sa, sb) = (a.collider.shape(), b.collider.shape());
     // The normal must be a separating axis: parry's hull-against-hull path finds one by GJK
     // each step and keeps it, with or without points, so two hulls whose points are all
     // apart (or that have none) hold one. An overlap's normal can point out of the far side
     // of a thin wall, and box against box keeps the normal of a contact long gone when the
     // two are apart, and updates points in place while they move little: those pairs take
     // the whole speeds (measured: a spinning plank then went through a 1 cm wall).
-    let hull = |s: &dyn parry3d::shape::Shape| s.as_convex_polyhedron().is_some();
     let normal = match manifolds {
-        [m] if hull(&**sa) && hull(&**sb) && m.points.iter().all(|p| p.dist >= 0.0) => {
+        [m] if a.collider.is_hull()
+            && b.collider.is_hull()
+            && m.points.iter().all(|p| p.dist >= 0.0) =>
+        {
             (a.pose.rotation * m.local_n1).try_normalize()
         }
         _ => None,
