@@ -13,6 +13,9 @@ use bevy_platform::collections::HashMap;
 
 use crate::collision::narrow_phase::PairState;
 
+/// How many pairs a pass over the table reads ahead of its work (see [`PairTable::warm`]).
+pub(crate) const LOOK_AHEAD: usize = 32;
+
 /// A pair's key: its lower entity, then its higher one.
 pub(crate) type PairKey = (Entity, Entity);
 
@@ -59,6 +62,20 @@ impl PairTable {
     #[inline]
     pub fn at_mut(&mut self, slot: u32) -> Option<&mut PairState> {
         self.slots.get_mut(slot as usize)?.as_mut().map(|(_, s)| s)
+    }
+
+    /// Reads the first point of each of `slots`' states, to bring them into the cache.
+    ///
+    /// Why: a state is two pointers away from its slot (its manifolds, their points), each
+    /// a cache miss when pairs are many. A pass that reads every state in turn waits on
+    /// each; a short loop over a chunk of [`LOOK_AHEAD`] lets their reads overlap. On
+    /// Box3D's pile that was a sixth of the step.
+    #[inline]
+    pub fn warm(&self, slots: impl Iterator<Item = u32>) {
+        let first = slots
+            .filter_map(|slot| self.at(slot)?.manifolds.first()?.points.first())
+            .fold(0.0, |f, p| f + p.dist);
+        std::hint::black_box(first);
     }
 
     /// The slot of `key`, a new pair's when it is not one yet, marked seen at `step`.

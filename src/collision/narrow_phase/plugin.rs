@@ -9,6 +9,7 @@ use parry3d::query::{DefaultQueryDispatcher, PersistentQueryDispatcher};
 use crate::collision::ContactFilter;
 use crate::collision::broad_phase::BroadPhase;
 use crate::collision::narrow_phase::fetch::Wanted;
+use crate::collision::narrow_phase::pairs::LOOK_AHEAD;
 use crate::collision::narrow_phase::points::{PointsKey, choose_changed_points};
 use crate::collision::narrow_phase::{ActivePair, Contacts, Manifold, PairState, Recycle};
 use crate::collision::{Collider, ContactEnded, ContactSettings, ContactStarted, Sensor};
@@ -174,6 +175,36 @@ fn approach_speed(a: &NarrowBody, b: &NarrowBody, manifolds: &[Manifold]) -> f32
     }
 }
 
+/// The direction from `a`'s centre of mass to `b`'s when the two are farther apart than
+/// `reach` by their bounding spheres (each side's [`NarrowBody::reach`] about its centre of
+/// mass), so that no two of their points can come within `reach`.
+///
+/// Why: boxes overlap where the round shapes in them do not (a pile of hulls falling
+/// side by side, their boxes stretched by the fall), and parry's manifold costs a GJK
+/// search for each such pair to find no point.
+fn apart_beyond(a: &NarrowBody, b: &NarrowBody, reach: f32) -> Option<Vec3> {
+    let between = b.pose * b.centre - a.pose * a.centre;
+    let apart = between.length() - a.reach - b.reach;
+    (apart > reach).then(|| between.try_normalize()).flatten()
+}
+
+/// A pair's manifolds for two sides [`apart_beyond`] each other: no points. Two hulls'
+/// manifold keeps `axis` as its normal, as parry's keeps the separating axis its search
+/// found: it starts the next search, and [`approach_speed`] reads it (the axis between
+/// two disjoint balls separates what is inside them).
+fn set_apart(a: &NarrowBody, b: &NarrowBody, axis: Vec3, state: &mut PairState) {
+    for m in &mut state.manifolds {
+        m.points.clear();
+    }
+    if let ([m], true) = (
+        &mut state.manifolds[..],
+        a.collider.is_hull() && b.collider.is_hull(),
+    ) {
+        m.local_n1 = a.pose.rotation.inverse() * axis;
+        m.local_n2 = b.pose.rotation.inverse() * -axis;
+    }
+}
+
 /// parry's manifolds for a pair; two hulls go straight to parry's hull-against-hull
 /// manifold with their vertices in columns (see [`crate::collision::support`]), which is
 /// what parry's dispatcher calls for them, with a faster support point.
@@ -219,6 +250,117 @@ fn guarded<T>(failed: &mut bool, f: impl FnOnce() -> T) -> Option<T> {
     r
 }
 
+/// What every pair's update reads of the step.
+struct StepFrame {
+    /// [`ContactSettings::margin`] (m).
+    margin: f32,
+    /// The step (s).
+    dt: f32,
+    /// How far a pair may move and keep its points (m; see [`Recycle`]).
+    window: f32,
+    /// The separation under which a pair touches (m).
+    touch: f32,
+}
+
+/// Brings a pair's manifolds (and its impact cast) up to date; returns whether the two
+/// touch. Sets `failed` when parry failed on them and `updated` when the manifolds were
+/// found again rather than reused.
+fn update_manifolds(
+    ca: &NarrowBody,
+    cb: &NarrowBody,
+    state: &mut PairState,
+    frame: &StepFrame,
+    scratch: &mut Vec<(Vec3A, f32, bool)>,
+    failed: &mut bool,
+    updated: &mut bool,
+) -> bool {
+    let (pose_a, pose_b) = (&ca.pose, &cb.pose);
+    let prediction = frame.margin + approach_speed(ca, cb, &state.manifolds) * frame.dt;
+    let pos12 = pose_a.inverse() * *pose_b;
+    let changed = ca.changed || cb.changed;
+    match state.recycle {
+        Some(r) if !changed && r.holds(&pos12, cb.extent, prediction, frame.window) => {
+            for m in &mut state.manifolds {
+                m.update_separations(&part_pose12(m, &pos12));
+            }
+        }
+        _ => {
+            if changed {
+                // parry reuses points itself while a pose holds still, and cannot tell
+                // that a shape changed: start from nothing.
+                state.manifolds.clear();
+                state.workspace = None;
+            }
+            *updated = true;
+            let reach = prediction + frame.window;
+            let before = PointsKey::of(&state.manifolds);
+            let result = match apart_beyond(ca, cb, reach) {
+                Some(axis) => {
+                    set_apart(ca, cb, axis, state);
+                    Ok(())
+                }
+                None => guarded(&mut *failed, || {
+                    contact_manifolds(ca.collider, cb.collider, &pos12, reach, state)
+                })
+                .unwrap_or(Err(parry3d::query::Unsupported)),
+            };
+            // Two shapes cannot overlap by more than the narrower one's width,
+            // at most twice its reach. A deeper point is parry's GJK and EPA
+            // failing on a degenerate simplex (Box3D's pile: a hull 5.5 m "into"
+            // the ground along (−1, 1, −1)/√3), and pushing it out would kick the
+            // body sideways at the push-out speed: the pair starts afresh.
+            let deepest = 2.0 * ca.reach.min(cb.reach) + frame.margin;
+            let impossible =
+                (state.manifolds.iter().flat_map(|m| &m.points)).any(|p| p.dist < -deepest);
+            let result = match impossible {
+                true => Err(parry3d::query::Unsupported),
+                false => result,
+            };
+            if result.is_err() {
+                state.manifolds.clear();
+                state.workspace = None;
+            }
+            // parry keeps a manifold's points while the pose holds still (two
+            // hulls falling together), whatever today's reach: past it they
+            // cannot close within the step.
+            for m in &mut state.manifolds {
+                m.points.retain(|p| p.dist <= reach);
+            }
+            state.recycle =
+                (frame.window > 0.0 && result.is_ok()).then_some(Recycle { pos12, reach });
+            choose_changed_points(&mut state.manifolds, before, scratch);
+        }
+    }
+    let thin = crate::collision::narrow_phase::ccd::pair_thickness(ca.thin, cb.thin, frame.margin);
+    let fast = |sweep| crate::collision::narrow_phase::ccd::is_fast(sweep, frame.dt, thin);
+    // The local sweep is the finer bound and costs more: it is only asked of
+    // pairs the whole relative speed would cast.
+    let whole = (cb.velocity - ca.velocity).length() + ca.swing.max(cb.swing);
+    if fast(whole) && fast(whole.min(local_sweep(ca, cb))) {
+        let manifolds = &state.manifolds;
+        state.cast = guarded(&mut *failed, || {
+            crate::collision::narrow_phase::ccd::impact_manifold(
+                &ca.cast_side(),
+                &cb.cast_side(),
+                frame.dt,
+                thin,
+                manifolds,
+                scratch,
+            )
+        })
+        .flatten()
+        .map(Box::new);
+    }
+    state
+        .manifolds
+        .iter()
+        .flat_map(|m| &m.points)
+        .any(|p| p.dist < frame.touch)
+}
+
+/// A slot no pair holds.
+const NO_SLOT: u32 = u32::MAX;
+
 /// How often (steps) the pair table is put back in the broad phase's order.
 const REORDER_EVERY: u64 = 16;
 
@@ -262,141 +404,87 @@ pub(crate) fn update_contacts(
         // Zero, negative or not a number: no reuse.
         _ => 0.0,
     };
+    let frame = StepFrame {
+        margin: settings.margin,
+        dt,
+        window,
+        touch,
+    };
     let mut updated = 0;
-    for (&(a, b), &(sa, sb)) in bp.pairs.iter().zip(pair_slots.iter()) {
-        let (Some(ca), Some(cb)) = (&bodies[sa as usize], &bodies[sb as usize]) else {
-            continue;
-        };
-        let (pose_a, pose_b) = (&ca.pose, &cb.pose);
-        let sensor = ca.sensor || cb.sensor;
-        let slot = contacts.pairs.see((a, b), step);
-        let Some(state) = contacts.pairs.at_mut(slot) else {
-            continue;
-        };
-        state.sensor = sensor;
-        state.cast = None;
-        // parry can still panic on shapes at the edge of its domain (EPA's index panic was
-        // seen on huge or badly turned shapes): each parry call is guarded, and one bad pair
-        // loses its contact and its moving sides are quarantined while the step goes on.
-        let mut failed = false;
-        let touching = {
-            if sensor {
-                let (sa, sb) = (&**ca.collider.shape(), &**cb.collider.shape());
-                guarded(&mut failed, || {
-                    parry3d::query::intersection_test(pose_a, sa, pose_b, sb)
-                })
-                .is_some_and(|r| r.is_ok_and(|i| i.intersecting))
-            } else {
-                let prediction = settings.margin + approach_speed(ca, cb, &state.manifolds) * dt;
-                let pos12 = pose_a.inverse() * *pose_b;
-                let changed = ca.changed || cb.changed;
-                match state.recycle {
-                    Some(r) if !changed && r.holds(&pos12, cb.extent, prediction, window) => {
-                        for m in &mut state.manifolds {
-                            m.update_separations(&part_pose12(m, &pos12));
-                        }
-                    }
-                    _ => {
-                        if changed {
-                            // parry reuses points itself while a pose holds still, and cannot tell
-                            // that a shape changed: start from nothing.
-                            state.manifolds.clear();
-                            state.workspace = None;
-                        }
-                        updated += 1;
-                        let reach = prediction + window;
-                        let before = PointsKey::of(&state.manifolds);
-                        let result = guarded(&mut failed, || {
-                            contact_manifolds(ca.collider, cb.collider, &pos12, reach, state)
-                        })
-                        .unwrap_or(Err(parry3d::query::Unsupported));
-                        // Two shapes cannot overlap by more than the narrower one's width,
-                        // at most twice its reach. A deeper point is parry's GJK and EPA
-                        // failing on a degenerate simplex (Box3D's pile: a hull 5.5 m "into"
-                        // the ground along (−1, 1, −1)/√3), and pushing it out would kick the
-                        // body sideways at the push-out speed: the pair starts afresh.
-                        let deepest = 2.0 * ca.reach.min(cb.reach) + settings.margin;
-                        let impossible = (state.manifolds.iter().flat_map(|m| &m.points))
-                            .any(|p| p.dist < -deepest);
-                        let result = match impossible {
-                            true => Err(parry3d::query::Unsupported),
-                            false => result,
-                        };
-                        if result.is_err() {
-                            state.manifolds.clear();
-                            state.workspace = None;
-                        }
-                        // parry keeps a manifold's points while the pose holds still (two
-                        // hulls falling together), whatever today's reach: past it they
-                        // cannot close within the step.
-                        for m in &mut state.manifolds {
-                            m.points.retain(|p| p.dist <= reach);
-                        }
-                        state.recycle =
-                            (window > 0.0 && result.is_ok()).then_some(Recycle { pos12, reach });
-                        choose_changed_points(&mut state.manifolds, before, scratch);
-                    }
-                }
-                let thin = crate::collision::narrow_phase::ccd::pair_thickness(
-                    ca.thin,
-                    cb.thin,
-                    settings.margin,
-                );
-                let sweep = ((cb.velocity - ca.velocity).length() + ca.swing.max(cb.swing))
-                    .min(local_sweep(ca, cb));
-                if crate::collision::narrow_phase::ccd::is_fast(sweep, dt, thin) {
-                    let manifolds = &state.manifolds;
-                    state.cast = guarded(&mut failed, || {
-                        crate::collision::narrow_phase::ccd::impact_manifold(
-                            &ca.cast_side(),
-                            &cb.cast_side(),
-                            dt,
-                            thin,
-                            manifolds,
-                            scratch,
-                        )
-                    })
-                    .flatten()
-                    .map(Box::new);
-                }
-                state
-                    .manifolds
-                    .iter()
-                    .flat_map(|m| &m.points)
-                    .any(|p| p.dist < touch)
-            }
-        };
-        let touching = if failed {
-            state.manifolds.clear();
-            state.workspace = None;
-            state.recycle = None;
-            state.cast = None;
-            for (side, body, other) in [(a, ca, b), (b, cb, a)] {
-                if body.moving {
-                    commands
-                        .entity(side)
-                        .try_insert(crate::core::quarantine::Quarantined {
-                            reason: crate::core::quarantine::QuarantineReason::GeometryFailed {
-                                other,
-                            },
-                        });
-                }
-            }
-            false
-        } else {
-            touching
-        };
-        if touching != state.touching {
-            state.touching = touching;
-            if touching {
-                started.write(ContactStarted { a, b });
-            } else {
-                ended.write(ContactEnded { a, b });
-            }
+    let mut slots = [NO_SLOT; LOOK_AHEAD];
+    for (chunk, chunk_slots) in bp
+        .pairs
+        .chunks(LOOK_AHEAD)
+        .zip(pair_slots.chunks(LOOK_AHEAD))
+    {
+        // A chunk's pairs are found in the index, then their states read, each in a short
+        // loop of its own whose cache misses overlap (see `PairTable::warm`).
+        for ((&key, &(sa, sb)), slot) in chunk.iter().zip(chunk_slots).zip(&mut slots) {
+            *slot = match bodies[sa as usize].is_some() && bodies[sb as usize].is_some() {
+                true => contacts.pairs.see(key, step),
+                false => NO_SLOT,
+            };
         }
-        // The solver takes the pairs with points, by slot, without reading them again.
-        if !sensor && state.solved().any(|m| !m.points.is_empty()) {
-            contacts.active.push(ActivePair { slot, a, b });
+        contacts.pairs.warm(slots[..chunk.len()].iter().copied());
+        for ((&(a, b), &(sa, sb)), &slot) in chunk.iter().zip(chunk_slots).zip(&slots) {
+            let (Some(ca), Some(cb)) = (&bodies[sa as usize], &bodies[sb as usize]) else {
+                continue;
+            };
+            let (pose_a, pose_b) = (&ca.pose, &cb.pose);
+            let sensor = ca.sensor || cb.sensor;
+            let Some(state) = contacts.pairs.at_mut(slot) else {
+                continue;
+            };
+            state.sensor = sensor;
+            state.cast = None;
+            // parry can still panic on shapes at the edge of its domain (EPA's index panic was
+            // seen on huge or badly turned shapes): each parry call is guarded, and one bad pair
+            // loses its contact and its moving sides are quarantined while the step goes on.
+            let (mut failed, mut renewed) = (false, false);
+            let touching = {
+                if sensor {
+                    let (sa, sb) = (&**ca.collider.shape(), &**cb.collider.shape());
+                    guarded(&mut failed, || {
+                        parry3d::query::intersection_test(pose_a, sa, pose_b, sb)
+                    })
+                    .is_some_and(|r| r.is_ok_and(|i| i.intersecting))
+                } else {
+                    update_manifolds(ca, cb, state, &frame, scratch, &mut failed, &mut renewed)
+                }
+            };
+            let touching = if failed {
+                state.manifolds.clear();
+                state.workspace = None;
+                state.recycle = None;
+                state.cast = None;
+                for (side, body, other) in [(a, ca, b), (b, cb, a)] {
+                    if body.moving {
+                        commands
+                            .entity(side)
+                            .try_insert(crate::core::quarantine::Quarantined {
+                                reason: crate::core::quarantine::QuarantineReason::GeometryFailed {
+                                    other,
+                                },
+                            });
+                    }
+                }
+                false
+            } else {
+                touching
+            };
+            if touching != state.touching {
+                state.touching = touching;
+                if touching {
+                    started.write(ContactStarted { a, b });
+                } else {
+                    ended.write(ContactEnded { a, b });
+                }
+            }
+            updated += usize::from(renewed);
+            // The solver takes the pairs with points, by slot, without reading them again.
+            if !sensor && state.solved().any(|m| !m.points.is_empty()) {
+                contacts.active.push(ActivePair { slot, a, b });
+            }
         }
     }
     contacts.updated = updated;

@@ -7,6 +7,7 @@ use parry3d::math::Pose;
 
 use crate::collision::ContactFilter;
 use crate::collision::narrow_phase::fetch::Wanted;
+use crate::collision::narrow_phase::pairs::LOOK_AHEAD;
 use crate::collision::narrow_phase::points::MAX_POINTS;
 use crate::collision::narrow_phase::{ActivePair, Contacts, FrozenGeometry};
 use crate::collision::solver::{ContactSolver, FIXED, ManifoldConstraint, PointInput, SolverBody};
@@ -310,7 +311,14 @@ pub(crate) fn prepare_contacts(
     }
     // Freezing a manifold's geometry is bookkeeping, not a change anyone listens for.
     let contacts = contacts.bypass_change_detection();
-    for &(slot, sa, sb) in pairs.iter() {
+    for (k, &(slot, sa, sb)) in pairs.iter().enumerate() {
+        // A chunk's states are read in one short loop first, so that their scattered
+        // memory arrives together (see `PairTable::warm`).
+        if k % LOOK_AHEAD == 0 {
+            contacts
+                .pairs
+                .warm(pairs[k..].iter().take(LOOK_AHEAD).map(|p| p.0));
+        }
         let Some(state) = contacts.pairs.at_mut(slot) else {
             continue;
         };
