@@ -381,13 +381,6 @@ impl Collider {
         self.bounds
     }
 
-    /// Whether the shape is a convex hull (read from the kept columns, not by asking the
-    /// shape its type: the narrow phase asks for every pair and step).
-    #[must_use]
-    pub(crate) fn is_hull(&self) -> bool {
-        self.lanes.is_some()
-    }
-
     /// The shape as a hull with its vertices in columns, if it is a hull.
     #[must_use]
     pub(crate) fn laned_hull(&self) -> Option<support::LanedHull<'_>> {

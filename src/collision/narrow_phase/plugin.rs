@@ -138,70 +138,88 @@ fn local_sweep(a: &NarrowBody, b: &NarrowBody) -> f32 {
     (small.velocity - there).length() + (sa.spin - sb.spin).length() * small.reach
 }
 
+/// The normal of the pair's manifold and the gap along it, if it is a separating axis
+/// (parry keeps the separating axis its search found, with or without points). `n1` is in
+/// `a`'s shape frame; the gap (m) is how far `b` lies beyond `a` along it, at least 0.
+///
+/// Why it is tested rather than trusted: an overlap's normal can point out of the far side
+/// of a thin wall, and box against box keeps the normal of a contact long gone while the
+/// two are apart (measured: a spinning plank trusted such a normal and went through a 1 cm
+/// wall). Why only the normal parry found: the points are measured along it, and along
+/// another axis (the line between the centres of mass) a leaning box's far corner lost its
+/// speculative point, and a column of 200 boxes strayed 0.74 m where it stands.
+fn separating_axis(
+    a: &NarrowBody,
+    b: &NarrowBody,
+    pos12: &Pose,
+    manifolds: &[Manifold],
+) -> Option<Separation> {
+    // A compound's manifolds are in its parts' frames.
+    let [m] = manifolds else { return None };
+    let n1 = m.local_n1.try_normalize()?;
+    let gap = gap_along(a.collider, b.collider, pos12, n1)?;
+    (gap >= 0.0).then_some(Separation { n1, gap })
+}
+
+/// The gap between the two sides' bounding spheres (m; negative where they overlap): each
+/// side's [`NarrowBody::reach`] about its centre of mass. No two points of the shapes are
+/// closer.
+fn spheres_gap(a: &NarrowBody, b: &NarrowBody) -> f32 {
+    (b.pose * b.centre - a.pose * a.centre).length() - a.reach - b.reach
+}
+
+/// A separating axis of a pair (see [`separating_axis`]).
+#[derive(Clone, Copy)]
+struct Separation {
+    /// The axis, from the first side to the second, in the first side's shape frame.
+    n1: Vec3,
+    /// How far apart the two are along it (m).
+    gap: f32,
+}
+
+/// How far `b` lies beyond `a` along the unit `n1` (in `a`'s frame; m, negative where
+/// they overlap along it), by the shapes' support points; `None` unless both shapes have
+/// one (compounds, meshes and planes do not).
+#[must_use]
+fn gap_along(a: &Collider, b: &Collider, pos12: &Pose, n1: Vec3) -> Option<f32> {
+    let n2 = pos12.rotation.inverse() * -n1;
+    Some(pos12.translation.dot(n1) - support_along(a, n1)? - support_along(b, n2)?)
+}
+
+/// The farthest any point of `c` reaches along `dir` in its own frame (m).
+#[inline]
+fn support_along(c: &Collider, dir: Vec3) -> Option<f32> {
+    use parry3d::shape::SupportMap;
+    match c.laned_hull() {
+        Some(hull) => Some(hull.local_support_point(dir).dot(dir)),
+        None => Some(
+            c.shape()
+                .as_support_map()?
+                .local_support_point(dir)
+                .dot(dir),
+        ),
+    }
+}
+
 /// How fast the pair can close within the step (m/s), for the prediction distance.
 ///
 /// Each side may keep its velocity or be stopped by a third body mid-step, so the bound is
 /// each side's speed toward the other, summed, plus how fast each one's spin moves its
 /// surface ([`crate::collision::radii::surface_swing`]; none for a ball about its centre).
-/// "Toward" is along the separating axis of the last step (two hulls that were apart, see
-/// below): to touch, the two must close the gap along it. Without one it is each side's
-/// whole speed.
+/// "Toward" is along a separating axis (see [`separating_axis`]): to touch, the two must
+/// close the gap along it. Without one it is each side's whole speed.
 ///
 /// Why: Box3D's pile drops 5,120 hulls side by side. Counting the whole speed of each gave
 /// neighbours falling together a prediction of metres, and parry then found speculative
 /// points between every pair of them, three times rapier's points, that could never close.
 /// A hull above another that lands still sees the full speed along their normal.
-fn approach_speed(a: &NarrowBody, b: &NarrowBody, manifolds: &[Manifold]) -> f32 {
-    // The normal must be a separating axis: parry's hull-against-hull path finds one by GJK
-    // each step and keeps it, with or without points, so two hulls whose points are all
-    // apart (or that have none) hold one. An overlap's normal can point out of the far side
-    // of a thin wall, and box against box keeps the normal of a contact long gone when the
-    // two are apart, and updates points in place while they move little: those pairs take
-    // the whole speeds (measured: a spinning plank then went through a 1 cm wall).
-    let normal = match manifolds {
-        [m] if a.collider.is_hull()
-            && b.collider.is_hull()
-            && m.points.iter().all(|p| p.dist >= 0.0) =>
-        {
-            (a.pose.rotation * m.local_n1).try_normalize()
-        }
-        _ => None,
-    };
-    match normal {
-        Some(n) => {
+fn approach_speed(a: &NarrowBody, b: &NarrowBody, separation: Option<Separation>) -> f32 {
+    match separation {
+        Some(Separation { n1, .. }) => {
+            let n = a.pose.rotation * n1;
             a.velocity.dot(n).max(0.0) + (-b.velocity.dot(n)).max(0.0) + a.surface + b.surface
         }
         None => a.speed + b.speed,
-    }
-}
-
-/// The direction from `a`'s centre of mass to `b`'s when the two are farther apart than
-/// `reach` by their bounding spheres (each side's [`NarrowBody::reach`] about its centre of
-/// mass), so that no two of their points can come within `reach`.
-///
-/// Why: boxes overlap where the round shapes in them do not (a pile of hulls falling
-/// side by side, their boxes stretched by the fall), and parry's manifold costs a GJK
-/// search for each such pair to find no point.
-fn apart_beyond(a: &NarrowBody, b: &NarrowBody, reach: f32) -> Option<Vec3> {
-    let between = b.pose * b.centre - a.pose * a.centre;
-    let apart = between.length() - a.reach - b.reach;
-    (apart > reach).then(|| between.try_normalize()).flatten()
-}
-
-/// A pair's manifolds for two sides [`apart_beyond`] each other: no points. Two hulls'
-/// manifold keeps `axis` as its normal, as parry's keeps the separating axis its search
-/// found: it starts the next search, and [`approach_speed`] reads it (the axis between
-/// two disjoint balls separates what is inside them).
-fn set_apart(a: &NarrowBody, b: &NarrowBody, axis: Vec3, state: &mut PairState) {
-    for m in &mut state.manifolds {
-        m.points.clear();
-    }
-    if let ([m], true) = (
-        &mut state.manifolds[..],
-        a.collider.is_hull() && b.collider.is_hull(),
-    ) {
-        m.local_n1 = a.pose.rotation.inverse() * axis;
-        m.local_n2 = b.pose.rotation.inverse() * -axis;
     }
 }
 
@@ -275,8 +293,9 @@ fn update_manifolds(
     updated: &mut bool,
 ) -> bool {
     let (pose_a, pose_b) = (&ca.pose, &cb.pose);
-    let prediction = frame.margin + approach_speed(ca, cb, &state.manifolds) * frame.dt;
     let pos12 = pose_a.inverse() * *pose_b;
+    let separation = separating_axis(ca, cb, &pos12, &state.manifolds);
+    let prediction = frame.margin + approach_speed(ca, cb, separation) * frame.dt;
     let changed = ca.changed || cb.changed;
     match state.recycle {
         Some(r) if !changed && r.holds(&pos12, cb.extent, prediction, frame.window) => {
@@ -294,16 +313,24 @@ fn update_manifolds(
             *updated = true;
             let reach = prediction + frame.window;
             let before = PointsKey::of(&state.manifolds);
-            let result = match apart_beyond(ca, cb, reach) {
-                Some(axis) => {
-                    set_apart(ca, cb, axis, state);
-                    Ok(())
-                }
-                None => guarded(&mut *failed, || {
-                    contact_manifolds(ca.collider, cb.collider, &pos12, reach, state)
-                })
-                .unwrap_or(Err(parry3d::query::Unsupported)),
-            };
+            // Two sides farther apart than the reach along an axis have no points, and
+            // parry's search would cost as much as for a contact to find none. Boxes overlap
+            // where the shapes in them do not (a pile of hulls falling side by side, their
+            // boxes stretched by the fall): their bounding spheres tell most such pairs.
+            // Their normals stay, to start parry's next search.
+            let result =
+                match separation.is_some_and(|s| s.gap > reach) || spheres_gap(ca, cb) > reach {
+                    true => {
+                        for m in &mut state.manifolds {
+                            m.points.clear();
+                        }
+                        Ok(())
+                    }
+                    false => guarded(&mut *failed, || {
+                        contact_manifolds(ca.collider, cb.collider, &pos12, reach, state)
+                    })
+                    .unwrap_or(Err(parry3d::query::Unsupported)),
+                };
             // Two shapes cannot overlap by more than the narrower one's width,
             // at most twice its reach. A deeper point is parry's GJK and EPA
             // failing on a degenerate simplex (Box3D's pile: a hull 5.5 m "into"
