@@ -156,6 +156,12 @@ fn separating_axis(
 ) -> Option<Separation> {
     // A compound's manifolds are in its parts' frames.
     let [m] = manifolds else { return None };
+    // A point that overlapped in the last step all but rules the normal out, and a resting
+    // pair's is such: the support points are not worth asking (a twelfth of the 100-row
+    // pyramid's step). Going without only keeps the whole speeds.
+    if m.points.iter().any(|p| p.dist < 0.0) {
+        return None;
+    }
     let n1 = m.local_n1.try_normalize()?;
     let gap = gap_along(a.collider, b.collider, pos12, n1)?;
     (gap >= 0.0).then_some(Separation { n1, gap })
