@@ -157,8 +157,8 @@ fn separating_axis(
     // A compound's manifolds are in its parts' frames.
     let [m] = manifolds else { return None };
     // A point that overlapped in the last step all but rules the normal out, and a resting
-    // pair's is such: the support points are not worth asking (a twelfth of the 100-row
-    // pyramid's step). Going without only keeps the whole speeds.
+    // pair's is such: the support points are not worth asking (asked, they took 8 % of the
+    // full 100-row pyramid's profile samples). Going without only keeps the whole speeds.
     if m.points.iter().any(|p| p.dist < 0.0) {
         return None;
     }
