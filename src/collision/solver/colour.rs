@@ -16,9 +16,11 @@ impl ContactSolver {
         self.any_deep = self.bodies.iter().any(|b| b.deep);
         self.states.clear();
         self.states.resize(self.bodies.len() + 1, BodyState::REST);
-        let words = self.bodies.len().div_ceil(64);
+        // Per body, a bit for each colour it is in: the first free colour of a manifold is
+        // the lowest bit clear in both sides' masks.
+        let max_colours = max_colours.min(u32::BITS as usize);
         self.used.clear();
-        self.used.resize(words * max_colours, 0);
+        self.used.resize(self.bodies.len(), 0);
         self.colours.resize_with(max_colours, Vec::new);
         for c in &mut self.colours {
             c.clear();
@@ -31,23 +33,24 @@ impl ContactSolver {
                 .filter(|b| b.dynamic)
                 .map(|_| i as usize)
         };
+        let all = if max_colours == 32 {
+            !0
+        } else {
+            (1u32 << max_colours) - 1
+        };
         for (mi, m) in self.manifolds.iter().enumerate() {
             let sides = [movable(m.a), movable(m.b)];
-            let free = |used: &[u64], c: usize| {
-                sides
-                    .iter()
-                    .flatten()
-                    .all(|&i| used[c * words + i / 64] & (1 << (i % 64)) == 0)
-            };
-            match (0..max_colours).find(|&c| free(used, c)) {
-                Some(c) => {
-                    for &i in sides.iter().flatten() {
-                        used[c * words + i / 64] |= 1 << (i % 64);
-                    }
-                    self.colours[c].push(mi as u32);
-                }
-                None => overflow.push(mi as u32),
+            let taken = sides.iter().flatten().fold(0, |t, &i| t | used[i]);
+            let free = !taken & all;
+            if free == 0 {
+                overflow.push(mi as u32);
+                continue;
             }
+            let c = free.trailing_zeros();
+            for &i in sides.iter().flatten() {
+                used[i] |= 1 << c;
+            }
+            self.colours[c as usize].push(mi as u32);
         }
         let colours = std::mem::take(&mut self.colours);
         for c in &colours {
@@ -81,12 +84,14 @@ impl ContactSolver {
             .max()
             .unwrap_or(0);
         let fixed = std::array::from_fn(|l| lane(l).is_some_and(|m| m.a == FIXED || m.b == FIXED));
-        let batch = Batch {
+        let mut batch = Batch {
             lanes: std::array::from_fn(|l| chunk.get(l).copied().unwrap_or(u32::MAX)),
             a,
             b,
             first: self.points.len() as u32,
             count,
+            // Set below for a batch that bounces.
+            tracked: Batch::UNTRACKED,
             n: vector(|m| m.n),
             t: [vector(|m| m.t[0]), vector(|m| m.t[1])],
             // Set with the axes.
@@ -97,6 +102,9 @@ impl ContactSolver {
             threshold: scalar(|m| -m.threshold),
             fixed: F4::new(fixed.map(|f| if f { f32::from_bits(!0) } else { 0.0 })),
         };
+        if batch.bouncy() {
+            batch.tracked = self.tracks.len() as u32;
+        }
         for k in 0..count {
             // Lanes past a manifold's last point stay zero (their masses are zeroed too).
             let (mut r_a, mut r_b) = ([Vec3A::ZERO; 4], [Vec3A::ZERO; 4]);
@@ -118,6 +126,9 @@ impl ContactSolver {
                 normal: Axis::default(),
                 n_imp: F4::new(s[1]),
             });
+            if batch.tracked == Batch::UNTRACKED {
+                continue;
+            }
             self.tracks.push(Track {
                 max_n: F4::ZERO,
                 approach: F4::new(s[2]),

@@ -262,6 +262,9 @@ struct Batch {
     /// Points `first..first + count` of [`ContactSolver::points`].
     first: u32,
     count: u32,
+    /// Its points' restitution records start at this index of [`ContactSolver::tracks`];
+    /// [`Batch::UNTRACKED`] for a batch that does not bounce, which keeps none.
+    tracked: u32,
     n: V3,
     t: [V3; 2],
     inv_m_a: F4,
@@ -276,6 +279,19 @@ struct Batch {
 }
 
 impl Batch {
+    /// [`Batch::tracked`] of a batch without restitution records.
+    const UNTRACKED: u32 = u32::MAX;
+
+    /// Where its points' restitution records are in [`ContactSolver::tracks`] (empty for a
+    /// batch that does not bounce).
+    #[inline]
+    fn tracks(&self) -> std::ops::Range<usize> {
+        match self.tracked {
+            Self::UNTRACKED => 0..0,
+            t => t as usize..(t + self.count) as usize,
+        }
+    }
+
     /// Some lane bounces (restitution > 0; empty lanes hold 0): only then do the passes
     /// keep the record the restitution reads (impact speeds, the energy the impulses took
     /// out). A batch without restitution gives it nothing either way, so skipping it
@@ -299,7 +315,7 @@ pub(crate) struct ContactSolver {
     pub order: crate::collision::solver::exchange::StorageOrder,
     batches: Vec<Batch>,
     points: Vec<Point>,
-    /// Per point, its restitution record.
+    /// Per point of a bouncy batch, its restitution record (see [`Batch::tracked`]).
     tracks: Vec<Track>,
     /// Per batch: its manifolds' friction.
     friction: Vec<friction::Friction>,
@@ -309,11 +325,13 @@ pub(crate) struct ContactSolver {
     grounded_only: bool,
     /// Colouring scratch, kept to reuse its memory.
     colours: Vec<Vec<u32>>,
-    used: Vec<u64>,
+    used: Vec<u32>,
     /// Bodies whose inertia a gather turned (see [`Self::after_gather`]), and a per-body
     /// mark for the batch scan.
     pub turned: Vec<u32>,
     turned_mark: Vec<bool>,
+    /// Per manifold, its impulses at the end of the step (see [`write_back`]).
+    solved: Vec<write_back::Solved>,
 }
 
 /// Solver index per entity.
@@ -511,8 +529,9 @@ impl ContactSolver {
             .lanes
             .map(|mi| self.manifolds.get(mi as usize).map_or(0, |m| m.count));
         let range = batch.first as usize..(batch.first + batch.count) as usize;
-        let (points, tracks) = (&mut self.points[range.clone()], &mut self.tracks[range]);
-        for (k, (p, t)) in points.iter_mut().zip(tracks).enumerate() {
+        let points = &mut self.points[range];
+        let tracks = &mut self.tracks[batch.tracks()];
+        for (k, p) in points.iter_mut().enumerate() {
             let live = F4::new(counts.map(|c| {
                 if (k as u32) < c {
                     f32::from_bits(!0)
@@ -521,11 +540,13 @@ impl ContactSolver {
                 }
             }));
             p.normal = Axis::new(ma, &ia, p.r_a, mb, &ib, p.r_b, batch.n, live);
-            t.half_w = p
-                .normal
-                .mass
-                .simd_gt(F4::ZERO)
-                .select(F4::splat(0.5) / p.normal.mass, F4::ZERO);
+            if let Some(t) = tracks.get_mut(k) {
+                t.half_w = p
+                    .normal
+                    .mass
+                    .simd_gt(F4::ZERO)
+                    .select(F4::splat(0.5) / p.normal.mass, F4::ZERO);
+            }
         }
         let lanes = F4::new(counts.map(|c| if c > 0 { f32::from_bits(!0) } else { 0.0 }));
         self.friction[bi].compute(&batch, (ma, &ia), (mb, &ib), lanes);
@@ -631,7 +652,7 @@ impl ContactSolver {
                 Self::load(states, batch.b, batch.inv_m_b),
             ];
             let range = batch.first as usize..(batch.first + batch.count) as usize;
-            let points = (&mut points[range.clone()], &mut tracks[range]);
+            let points = (&mut points[range], &mut tracks[batch.tracks()]);
             f(batch, friction, points, states, &mut sides);
             Self::store(states, batch.a, &sides[0]);
             Self::store(states, batch.b, &sides[1]);
@@ -730,71 +751,36 @@ impl ContactSolver {
                 impulse_scale,
                 max_push,
             };
-            let bouncy = batch.bouncy();
-            let mut visit = |(p, t): (&mut Point, &mut Track)| {
-                if bouncy {
+            if batch.bouncy() {
+                let mut visit = |(p, t): (&mut Point, &mut Track)| {
                     pass.point::<BIAS, true>(p, t, a, b);
-                } else {
-                    // `t` is not read: a batch that does not bounce leaves its tracks out of
-                    // the cache.
-                    pass.point::<BIAS, false>(p, t, a, b);
+                };
+                let pairs = points.iter_mut().zip(tracks.iter_mut());
+                match BIAS {
+                    true => pairs.for_each(&mut visit),
+                    false => pairs.rev().for_each(&mut visit),
                 }
-            };
-            let pairs = points.iter_mut().zip(tracks.iter_mut());
-            if BIAS {
-                pairs.for_each(&mut visit);
             } else {
-                pairs.rev().for_each(&mut visit);
+                // A batch that does not bounce keeps no record: this one is not read.
+                let mut unread = Track::default();
+                let mut visit = |p: &mut Point| pass.point::<BIAS, false>(p, &mut unread, a, b);
+                match BIAS {
+                    true => points.iter_mut().for_each(&mut visit),
+                    false => points.iter_mut().rev().for_each(&mut visit),
+                }
+            }
+            if !BIAS {
                 let normal = points.iter().fold(F4::ZERO, |s, p| s + p.n_imp);
                 friction.solve(batch, normal, a, b);
             }
         });
     }
-
-    /// Each manifold's accumulated impulses, for the next step's warm start: its
-    /// constraint, the normal impulse of each solved point (by its index in the narrow
-    /// phase's manifold), the friction impulse at its centre (world frame) and the twist.
-    pub fn manifold_impulses(&self) -> impl Iterator<Item = SolvedManifold<'_>> + '_ {
-        self.batches
-            .iter()
-            .zip(&self.friction)
-            .flat_map(move |(batch, f)| {
-                let points =
-                    &self.points[batch.first as usize..(batch.first + batch.count) as usize];
-                (0..4).filter_map(move |l| {
-                    let m = self.manifolds.get(batch.lanes[l] as usize)?;
-                    let inputs = &self.inputs[m.first as usize..(m.first + m.count) as usize];
-                    let mut normals =
-                        [(0, 0.0); crate::collision::narrow_phase::points::MAX_POINTS];
-                    for ((slot, p), input) in normals.iter_mut().zip(points).zip(inputs) {
-                        *slot = (input.source, p.n_imp.to_array()[l]);
-                    }
-                    let (t, twist) = f.lane(l);
-                    Some(SolvedManifold {
-                        constraint: m,
-                        normals,
-                        count: inputs.len(),
-                        tangent: t[0] * m.t[0] + t[1] * m.t[1],
-                        twist,
-                    })
-                })
-            })
-    }
-}
-
-/// One manifold's impulses after the step (see [`ContactSolver::manifold_impulses`]).
-pub(crate) struct SolvedManifold<'a> {
-    pub constraint: &'a ManifoldConstraint,
-    /// (point index in the narrow phase's manifold, normal impulse); the first `count`.
-    pub normals: [(u32, f32); crate::collision::narrow_phase::points::MAX_POINTS],
-    pub count: usize,
-    pub tangent: Vec3A,
-    pub twist: f32,
 }
 
 mod friction;
 mod limits;
 mod restitution;
+mod write_back;
 
 #[cfg(test)]
 mod tests;

@@ -87,14 +87,17 @@ pub(crate) fn relax_pass(
     }
     solver.limit_deep_speed(settings.max_push_velocity);
     if time.is_last() {
-        for solved in solver.manifold_impulses() {
+        solver.for_each_solved(|solved, ahead| {
+            if let Some(slot) = ahead {
+                contacts.pairs.prefetch(slot);
+            }
             let m = solved.constraint;
             let Some(tracked) = contacts
                 .pairs
                 .at_mut(m.pair)
                 .and_then(|s| s.manifolds.get_mut(m.manifold as usize))
             else {
-                continue;
+                return;
             };
             // (The time-of-impact manifold, after parry's, is not found here: it is not
             // warm-started.)
@@ -109,6 +112,6 @@ pub(crate) fn relax_pass(
             }
             tracked.data.tangent = solved.tangent.into();
             tracked.data.twist = solved.twist;
-        }
+        });
     }
 }

@@ -29,7 +29,7 @@ impl ContactSolver {
         // A batch that does not bounce kept no record (see `Batch::bouncy`) and adds nothing.
         for batch in batches.iter().filter(|b| b.bouncy()) {
             let e2 = batch.restitution * batch.restitution;
-            for t in &tracks[batch.first as usize..(batch.first + batch.count) as usize] {
+            for t in &tracks[batch.tracks()] {
                 let hit = t.approach.simd_lt(batch.threshold) & t.max_n.simd_gt(zero);
                 let m = t
                     .half_w
@@ -47,7 +47,7 @@ impl ContactSolver {
                 Self::load(states, batch.b, batch.inv_m_b),
             );
             let range = batch.first as usize..(batch.first + batch.count) as usize;
-            for (p, t) in points[range.clone()].iter_mut().zip(&tracks[range]) {
+            for (p, t) in points[range].iter_mut().zip(&tracks[batch.tracks()]) {
                 let hit = bouncy & t.approach.simd_lt(batch.threshold) & t.max_n.simd_gt(zero);
                 if !hit.any() {
                     continue;
