@@ -64,6 +64,7 @@ pub(crate) mod lanes;
 pub(crate) mod narrow_phase;
 pub(crate) mod nodes;
 mod plugin;
+pub(crate) mod prefetch;
 mod query;
 pub(crate) mod radii;
 pub(crate) mod slots;

@@ -75,8 +75,8 @@ impl PairTable {
         let first = slots
             .filter_map(|slot| self.at(slot)?.manifolds.first())
             .fold(0.0, |f, m| {
-                prefetch_lines(m);
-                prefetch_lines(m.points.as_slice());
+                crate::collision::prefetch::lines(m);
+                crate::collision::prefetch::lines(m.points.as_slice());
                 f + m.points.first().map_or(0.0, |p| p.dist)
             });
         std::hint::black_box(first);
@@ -88,8 +88,8 @@ impl PairTable {
     pub fn prefetch(&self, slot: u32) {
         if let Some(state) = self.at(slot) {
             for m in &state.manifolds {
-                prefetch_lines(m);
-                prefetch_lines(m.points.as_slice());
+                crate::collision::prefetch::lines(m);
+                crate::collision::prefetch::lines(m.points.as_slice());
             }
         }
     }
@@ -188,27 +188,6 @@ impl PairTable {
     pub fn values(&self) -> impl Iterator<Item = &PairState> {
         self.iter().map(|(_, s)| s)
     }
-}
-
-/// Asks the processor to start loading every cache line of `value` (a hint only: nothing is
-/// read, and elsewhere than on x86-64 it does nothing).
-#[inline]
-fn prefetch_lines<T: ?Sized>(value: &T) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        let start = std::ptr::from_ref(value).cast::<u8>();
-        for offset in (0..size_of_val(value)).step_by(64) {
-            // SAFETY: prefetching has no effect on memory or program state and never faults;
-            // the address is within `value`.
-            unsafe {
-                std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-                    start.wrapping_add(offset).cast::<i8>(),
-                );
-            }
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = value;
 }
 
 #[cfg(test)]

@@ -4,6 +4,9 @@
 
 use super::*;
 
+/// How many chunks of four ahead the colouring starts loading constraints.
+const AHEAD: usize = 4;
+
 impl ContactSolver {
     /// Colours the manifolds and lays them out in batches, with their effective masses.
     /// Call once per step after every body and manifold was added.
@@ -54,7 +57,8 @@ impl ContactSolver {
         }
         let colours = std::mem::take(&mut self.colours);
         for c in &colours {
-            for chunk in c.chunks(4) {
+            for (k, chunk) in c.chunks(4).enumerate() {
+                self.prefetch_chunks(c, k);
                 self.push_batch(chunk);
             }
         }
@@ -62,6 +66,27 @@ impl ContactSolver {
             self.push_batch(&[mi]);
         }
         self.colours = colours;
+    }
+
+    /// Starts loading the constraints of the chunk of four [`AHEAD`] chunks after the
+    /// `k`th of `colour`, and the point inputs of the one half as far: the colouring reads
+    /// them in colour order, a jump through memory for each.
+    #[inline]
+    fn prefetch_chunks(&self, colour: &[u32], k: usize) {
+        let chunk = |j: usize| colour.iter().skip(4 * j).take(4);
+        for &mi in chunk(k + AHEAD) {
+            if let Some(m) = self.manifolds.get(mi as usize) {
+                crate::collision::prefetch::lines(m);
+            }
+        }
+        for &mi in chunk(k + AHEAD / 2) {
+            if let Some(m) = self.manifolds.get(mi as usize) {
+                let inputs = self
+                    .inputs
+                    .get(m.first as usize..(m.first + m.count) as usize);
+                crate::collision::prefetch::lines(inputs.unwrap_or_default());
+            }
+        }
     }
 
     fn push_batch(&mut self, chunk: &[u32]) {
