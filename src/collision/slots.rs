@@ -34,3 +34,23 @@ impl EntitySlots {
         }
     }
 }
+
+/// A version of a list: a number no other version in this process has, so that a cache
+/// built from one version is never taken for another's, not even across a snapshot restore.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Stamp(u64);
+
+impl Stamp {
+    /// A version no other has.
+    #[must_use]
+    pub fn fresh() -> Self {
+        static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+        Self(NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed))
+    }
+}
+
+impl Default for Stamp {
+    fn default() -> Self {
+        Self::fresh()
+    }
+}

@@ -65,6 +65,10 @@ pub(crate) struct BroadPhase {
     found_before: Vec<(Entity, Entity)>,
     /// `pairs` is `found_before` sorted (false after a restore).
     pairs_from_found: bool,
+    /// The pairs before the last time they were sorted again (kept for its memory).
+    pairs_before: Vec<(Entity, Entity)>,
+    /// The version of `pairs`: new whenever they change.
+    pairs_stamp: crate::collision::slots::Stamp,
     /// The moving boxes in sweep order as six coordinate arrays, padded with empty boxes to
     /// whole lanes: the sweep tests four candidates at once.
     sweep: Sweep,
@@ -128,6 +132,8 @@ impl Default for BroadPhase {
             found: Vec::new(),
             found_before: Vec::new(),
             pairs_from_found: false,
+            pairs_before: Vec::new(),
+            pairs_stamp: crate::collision::slots::Stamp::fresh(),
             sweep: Sweep::default(),
             sizes: Vec::new(),
         }
@@ -293,6 +299,12 @@ impl BroadPhase {
         }
     }
 
+    /// The version of [`BroadPhase::pairs`]: the same as long as they did not change.
+    #[must_use]
+    pub fn pairs_stamp(&self) -> crate::collision::slots::Stamp {
+        self.pairs_stamp
+    }
+
     /// Sorts the moving boxes (insertion sort: cheap when they were nearly sorted) and
     /// collects every overlapping pair that may interact.
     pub fn find_pairs(&mut self) {
@@ -374,6 +386,7 @@ impl BroadPhase {
         // Sorting took a third of the broad phase of a 50-row pyramid at rest, whose pairs
         // come out of the sweep in the same order every step.
         if !(self.pairs_from_found && self.found == self.found_before) {
+            std::mem::swap(&mut self.pairs, &mut self.pairs_before);
             self.pairs.clone_from(&self.found);
             // The order of `(Entity, Entity)`, as one integer: cheaper to compare.
             self.pairs.sort_unstable_by_key(|&(a, b)| {
@@ -381,6 +394,12 @@ impl BroadPhase {
             });
             self.pairs.dedup();
             self.pairs_from_found = true;
+            // The sweep finds the same pairs in another order when boxes pass each other
+            // along its axis (in a resting pyramid, every step): the same list keeps its
+            // version.
+            if self.pairs != self.pairs_before {
+                self.pairs_stamp = crate::collision::slots::Stamp::fresh();
+            }
         }
         std::mem::swap(&mut self.found, &mut self.found_before);
     }
@@ -447,6 +466,7 @@ impl BroadPhase {
         self.cell_axis = record.cell_axis.min(2);
         self.pairs = pairs;
         self.pairs_from_found = false;
+        self.pairs_stamp = crate::collision::slots::Stamp::fresh();
         self.fixed_dirty = true;
         Ok(())
     }
@@ -595,9 +615,16 @@ mod tests {
                     e.max += shift;
                 }
                 let now = bp.moving.clone();
+                let (before, stamp) = (bp.pairs.clone(), bp.pairs_stamp());
                 bp.find_pairs();
                 assert_eq!(bp.pairs, brute_force(&now), "seed {seed}, step {step}");
+                // A new version exactly when the pairs changed.
+                assert_eq!(bp.pairs_stamp() == stamp, bp.pairs == before, "seed {seed}");
             }
+            // Nothing moved: the same pairs, the same version.
+            let stamp = bp.pairs_stamp();
+            bp.find_pairs();
+            assert_eq!(bp.pairs_stamp(), stamp, "seed {seed}");
         }
     }
 }

@@ -28,6 +28,8 @@ pub(crate) struct PairTable {
     /// Per slot: the narrow-phase step that last saw the pair.
     seen: Vec<u64>,
     free: Vec<u32>,
+    /// The version of the key-to-slot map: new whenever a pair gets or loses a slot.
+    stamp: crate::collision::slots::Stamp,
 }
 
 impl PairTable {
@@ -94,6 +96,21 @@ impl PairTable {
         }
     }
 
+    /// The version of the key-to-slot map (see [`crate::collision::slots::Stamp`]): while it
+    /// holds, every slot [`PairTable::slot`] gave still holds its pair.
+    #[must_use]
+    pub fn stamp(&self) -> crate::collision::slots::Stamp {
+        self.stamp
+    }
+
+    /// Marks the pair in `slot` seen at `step`.
+    #[inline]
+    pub fn mark_seen(&mut self, slot: u32, step: u64) {
+        if let Some(s) = self.seen.get_mut(slot as usize) {
+            *s = step;
+        }
+    }
+
     /// The slot of `key`, a new pair's when it is not one yet, marked seen at `step`.
     pub fn see(&mut self, key: PairKey, step: u64) -> u32 {
         let slot = match self.index.get(&key) {
@@ -125,12 +142,14 @@ impl PairTable {
             }
         };
         self.index.insert(key, slot);
+        self.stamp = crate::collision::slots::Stamp::fresh();
         slot
     }
 
     /// Removes `key`; returns its state.
     pub fn remove(&mut self, key: &PairKey) -> Option<PairState> {
         let slot = self.index.remove(key)?;
+        self.stamp = crate::collision::slots::Stamp::fresh();
         self.free.push(slot);
         self.slots[slot as usize].take().map(|(_, s)| s)
     }
@@ -154,6 +173,7 @@ impl PairTable {
         let old_seen = std::mem::take(&mut self.seen);
         self.free.clear();
         self.index.clear();
+        self.stamp = crate::collision::slots::Stamp::fresh();
         let mut put = |this: &mut Self, slot: u32| -> Option<u32> {
             let (key, mut state) = old.get_mut(slot as usize)?.take()?;
             state.manifolds = state.manifolds.clone();
@@ -219,6 +239,35 @@ mod tests {
             t.iter_seen()
                 .any(|(k, _, seen)| *k == key(2, 3) && seen == 3)
         );
+    }
+
+    #[test]
+    fn the_version_changes_exactly_when_a_pair_gets_or_loses_a_slot() {
+        let mut t = PairTable::default();
+        assert_ne!(
+            t.stamp(),
+            PairTable::default().stamp(),
+            "two tables share a version"
+        );
+        let v0 = t.stamp();
+        let a = t.see(key(1, 2), 1);
+        let v1 = t.stamp();
+        assert_ne!(v1, v0, "a new pair");
+        // Seeing a known pair, marking it seen, or replacing its state keeps every slot.
+        assert_eq!(t.see(key(1, 2), 2), a);
+        t.mark_seen(a, 3);
+        t.insert(key(1, 2), PairState::new(), 3);
+        assert_eq!(t.stamp(), v1);
+        assert!(t.unseen(3).next().is_none());
+        t.see(key(1, 3), 3);
+        let v2 = t.stamp();
+        assert_ne!(v2, v1, "another new pair");
+        t.remove(&key(1, 3));
+        let v3 = t.stamp();
+        assert_ne!(v3, v2, "a removal");
+        let mut order = [a];
+        t.reorder(order.iter_mut());
+        assert_ne!(t.stamp(), v3, "a reorder");
     }
 
     #[test]
