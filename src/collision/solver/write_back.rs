@@ -6,7 +6,7 @@ use glam::Vec3A;
 use super::{ContactSolver, ManifoldConstraint};
 use crate::collision::narrow_phase::points::MAX_POINTS;
 
-/// How many manifolds ahead [`ContactSolver::solved_manifolds`] shows its caller.
+/// How many manifolds ahead [`ContactSolver::for_each_solved`] shows its caller.
 const AHEAD: usize = 16;
 
 /// One manifold's impulses, gathered from its batch's lane.
@@ -17,7 +17,7 @@ pub(crate) struct Solved {
     twist: f32,
 }
 
-/// One manifold's impulses after the step (see [`ContactSolver::solved_manifolds`]).
+/// One manifold's impulses after the step (see [`ContactSolver::for_each_solved`]).
 pub(crate) struct SolvedManifold<'a> {
     pub constraint: &'a ManifoldConstraint,
     /// (point index in the narrow phase's manifold, normal impulse); the first `count`.
