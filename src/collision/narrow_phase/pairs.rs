@@ -66,26 +66,20 @@ impl PairTable {
         self.slots.get_mut(slot as usize)?.as_mut().map(|(_, s)| s)
     }
 
-    /// Reads the first point of each of `slots`' states, to bring them into the cache.
+    /// Starts loading each of `slots`' states (see [`PairTable::prefetch`]), for a pass
+    /// about to work through them.
     ///
     /// Why: a state is two pointers away from its slot (its manifolds, their points), each
     /// a cache miss when pairs are many. A pass that reads every state in turn waits on
-    /// each; a short loop over a chunk of [`LOOK_AHEAD`] lets their reads overlap. On
+    /// each; a short loop over a chunk of [`LOOK_AHEAD`] lets their loads overlap. On
     /// Box3D's pile that was a sixth of the step.
     #[inline]
     pub fn warm(&self, slots: impl Iterator<Item = u32>) {
-        let first = slots
-            .filter_map(|slot| self.at(slot)?.manifolds.first())
-            .fold(0.0, |f, m| {
-                crate::collision::prefetch::lines(m);
-                crate::collision::prefetch::lines(m.points.as_slice());
-                f + m.points.first().map_or(0.0, |p| p.dist)
-            });
-        std::hint::black_box(first);
+        slots.for_each(|slot| self.prefetch(slot));
     }
 
     /// Starts loading the state in `slot` (its manifolds and their points) into the cache,
-    /// without waiting for it: for a pass that will write them a few pairs later.
+    /// without waiting for it.
     #[inline]
     pub fn prefetch(&self, slot: u32) {
         if let Some(state) = self.at(slot) {

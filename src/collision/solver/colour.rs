@@ -36,11 +36,7 @@ impl ContactSolver {
                 .filter(|b| b.dynamic)
                 .map(|_| i as usize)
         };
-        let all = if max_colours == 32 {
-            !0
-        } else {
-            (1u32 << max_colours) - 1
-        };
+        let all = ((1u64 << max_colours) - 1) as u32;
         for (mi, m) in self.manifolds.iter().enumerate() {
             let sides = [movable(m.a), movable(m.b)];
             let taken = sides.iter().flatten().fold(0, |t, &i| t | used[i]);
