@@ -151,6 +151,7 @@ pub mod cloth;
 pub mod collision;
 pub mod core;
 pub mod integrator;
+pub mod joints;
 pub mod particles;
 mod plugins;
 pub mod rigid;
@@ -203,6 +204,10 @@ pub mod prelude {
     pub use crate::core::time::PhysicsTime;
     pub use crate::integrator::Integrator;
     pub use crate::integrator::IntegratorOverride;
+    pub use crate::joints::FixedJoint;
+    pub use crate::joints::JointImpulse;
+    pub use crate::joints::RevoluteJoint;
+    pub use crate::joints::SphericalJoint;
     pub use crate::particles::Advection;
     pub use crate::particles::ExternalForce;
     pub use crate::particles::ExternalImpulse;

@@ -8,6 +8,7 @@ use crate::core::error::Result;
 use crate::core::plugin::{self, PhysicsCorePlugin, WorldPlugin};
 use crate::core::time::FrameReport;
 use crate::integrator::IntegratorPlugin;
+use crate::joints::JointPlugin;
 use crate::particles::{DampingPlugin, GravityPlugin, VelocityFieldPlugin};
 use crate::rigid::RigidBodyPlugin;
 use crate::sleep::SleepPlugin;
@@ -28,6 +29,7 @@ impl WorldPlugin for PhysicsPlugins {
             .add_physics(SpringPlugin)
             .add_physics(RigidBodyPlugin)
             .add_physics(CollisionPlugin)
+            .add_physics(JointPlugin)
             .add_physics(SleepPlugin)
             .add_physics(SoftBodyPlugin)
             .add_physics(ClothPlugin);

@@ -78,6 +78,46 @@ pub use narrow_phase::{ContactPair, Contacts};
 pub(crate) use nodes::coupling::NodeImpulse;
 pub use plugin::CollisionPlugin;
 
+/// Pairs of bodies that never collide, whatever their layers; each pair counts its reasons
+/// (a joint between the two is one, see [`crate::joints`]), and collides again when none is
+/// left.
+#[derive(Resource, Debug, Default)]
+pub struct PairExclusions(bevy_platform::collections::HashMap<(Entity, Entity), u32>);
+
+impl PairExclusions {
+    fn key(a: Entity, b: Entity) -> (Entity, Entity) {
+        if a <= b { (a, b) } else { (b, a) }
+    }
+
+    /// One more reason for `a` and `b` not to collide.
+    pub fn add(&mut self, a: Entity, b: Entity) {
+        *self.0.entry(Self::key(a, b)).or_default() += 1;
+    }
+
+    /// One reason fewer (see [`Self::add`]).
+    pub fn remove(&mut self, a: Entity, b: Entity) {
+        let key = Self::key(a, b);
+        if let Some(n) = self.0.get_mut(&key) {
+            *n -= 1;
+            if *n == 0 {
+                self.0.remove(&key);
+            }
+        }
+    }
+
+    /// True when `a` and `b` do not collide.
+    #[must_use]
+    pub fn contains(&self, a: Entity, b: Entity) -> bool {
+        self.0.contains_key(&Self::key(a, b))
+    }
+
+    /// True when every pair may collide.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.0.is_empty()
+    }
+}
+
 pub(crate) use broad_phase::BroadPhaseRecord;
 
 /// The world pose of a manifold's part: the shape's pose, then the part's pose in it.

@@ -32,6 +32,7 @@ impl WorldPlugin for CollisionPlugin {
         );
         crate::core::restore::init::<super::ColliderChanges>(world);
         crate::core::restore::init::<BroadPhase>(world);
+        crate::core::restore::init::<super::PairExclusions>(world);
         crate::core::restore::init::<Contacts>(world);
         crate::core::restore::init::<ContactSolver>(world);
         crate::core::plugin::add_message::<ContactStarted>(world);

@@ -75,6 +75,9 @@ pub enum Error {
     /// A spring was asked to join an entity to itself.
     #[error("a spring cannot connect entity {0} to itself")]
     SelfSpring(Entity),
+    /// A joint was asked to join an entity to itself.
+    #[error("a joint cannot join entity {0} to itself")]
+    SelfJoint(Entity),
     /// A spring endpoint does not exist, or is not a body (has no `Position`).
     #[error("spring endpoint {0} does not exist or has no Position")]
     MissingEntity(Entity),

@@ -7,6 +7,7 @@ mod collision;
 mod common;
 mod docs;
 mod integrators;
+mod joints;
 mod particles;
 mod rigid;
 mod robustness;

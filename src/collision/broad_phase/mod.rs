@@ -305,9 +305,15 @@ impl BroadPhase {
         self.pairs_stamp
     }
 
-    /// Sorts the moving boxes (insertion sort: cheap when they were nearly sorted) and
-    /// collects every overlapping pair that may interact.
+    /// [`Self::find_pairs_except`] with no pair excluded.
+    #[cfg(test)]
     pub fn find_pairs(&mut self) {
+        self.find_pairs_except(&crate::collision::PairExclusions::default());
+    }
+
+    /// Sorts the moving boxes (insertion sort: cheap when they were nearly sorted) and
+    /// collects every overlapping pair that may interact and is not in `excluded`.
+    pub fn find_pairs_except(&mut self, excluded: &crate::collision::PairExclusions) {
         if self.moving_dirty {
             [self.axis, self.cell_axis] = sweep_axes(&self.moving);
         }
@@ -382,6 +388,9 @@ impl BroadPhase {
                     self.found.push(key(a.entity, b.entity));
                 }
             }
+        }
+        if !excluded.is_empty() {
+            self.found.retain(|p| !excluded.contains(p.0, p.1));
         }
         // Sorting took a third of the broad phase of a 50-row pyramid at rest, whose pairs
         // come out of the sweep in the same order every step.

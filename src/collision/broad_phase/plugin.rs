@@ -100,6 +100,7 @@ pub(crate) fn run_broad_phase(
     settings: Res<ContactSettings>,
     moving: Query<BroadCollider, (With<Collider>, With<LinearVelocity>, ContactFilter)>,
     fixed: Query<BroadCollider, (With<Collider>, Without<LinearVelocity>, ContactFilter)>,
+    excluded: Res<crate::collision::PairExclusions>,
 ) {
     let bp = &mut *bp;
     let fat = Vec3::splat(0.1 * settings.margin.max(0.0));
@@ -107,7 +108,7 @@ pub(crate) fn run_broad_phase(
         (e.min, e.max) = (e.min - fat, e.max + fat);
         e
     };
-    let mut changed = bp.moving_dirty || bp.fixed_dirty;
+    let mut changed = bp.moving_dirty || bp.fixed_dirty || excluded.is_changed();
     if !bp.moving_dirty {
         for e in &mut bp.moving {
             match moving.get(e.entity) {
@@ -141,6 +142,6 @@ pub(crate) fn run_broad_phase(
         bp.fixed.extend(fixed.iter().map(entry));
     }
     if changed {
-        bp.find_pairs();
+        bp.find_pairs_except(&excluded);
     }
 }

@@ -13,6 +13,7 @@ const LAYERS: &[&[&str]] = &[
     &["rigid"],
     &["integrator"],
     &["springs", "collision"],
+    &["joints"],
     &["sleep"],
     &["soft", "cloth"],
     &["plugins", "snapshot"],

@@ -275,6 +275,8 @@ fn every_substep_system_is_replicated_or_blocks_the_path() {
         "hooke::collision::nodes::coupling::apply_node_impulses", // NodeImpulse
         "hooke::cloth::plugin::apply_wind",          // Cloth
         "hooke::cloth::plugin::limit_strain",        // Cloth
+        "hooke::joints::plugin::solve_joints",       // SphericalJoint, RevoluteJoint, FixedJoint
+        "hooke::joints::plugin::relax_joints",       // SphericalJoint, RevoluteJoint, FixedJoint
         "hooke::collision::nodes::collide_nodes<hooke::cloth::Cloth>", // Cloth
     ];
     let mut world = World::new();

@@ -1,0 +1,207 @@
+//! The joint systems: a biased pass after the contacts' biased pass, a relax pass after the
+//! contacts' relax pass, each substep.
+
+use bevy_ecs::prelude::*;
+use glam::{Vec3, Vec3A};
+
+use super::solve::{self, Accumulated, Angular, Mode, Rows, Side};
+use super::{FixedJoint, JointBodies, JointImpulse, JointSettings, RevoluteJoint, SphericalJoint};
+use crate::core::plugin::WorldPlugin;
+use crate::core::quarantine::Quarantined;
+use crate::core::rest::Sleeping;
+use crate::core::schedule::{
+    CollisionSystems, PhysicsSchedule, PrepareSystems, RelaxSystems, StepSystems, SubstepSchedule,
+    add_own_systems,
+};
+use crate::core::time::SubstepTime;
+use crate::integrator::ConstraintsActive;
+use crate::particles::{LinearVelocity, Mass, Position};
+use crate::rigid::{AngularMomentum, AngularVelocity, CenterOfMass, Inertia, Rotation};
+
+/// Solves [`SphericalJoint`], [`RevoluteJoint`] and [`FixedJoint`] entities in the substeps,
+/// after the contacts in each pass. Its systems run only while a joint exists.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct JointPlugin;
+
+impl WorldPlugin for JointPlugin {
+    fn build(&self, world: &mut World) {
+        crate::core::restore::init::<JointSettings>(world);
+        // The whole-step path knows no joints: worlds with one take the schedule.
+        crate::core::whole_step::block_on::<SphericalJoint>(world);
+        crate::core::whole_step::block_on::<RevoluteJoint>(world);
+        crate::core::whole_step::block_on::<FixedJoint>(world);
+        let any = any_with_component::<JointImpulse>;
+        add_own_systems(
+            world,
+            PhysicsSchedule,
+            mark_constraints_active
+                .run_if(any)
+                .in_set(PrepareSystems::Collision)
+                .after(CollisionSystems::Constraints),
+        );
+        add_own_systems(
+            world,
+            SubstepSchedule,
+            (
+                solve_joints
+                    .run_if(any)
+                    .in_set(StepSystems::SolveConstraints)
+                    .after(crate::collision::solver::plugin::solve_contacts),
+                relax_joints
+                    .run_if(any)
+                    .in_set(RelaxSystems::Rigid)
+                    .after(crate::collision::solver::plugin::relax_contacts),
+            ),
+        );
+    }
+}
+
+type JointItem<'a> = (
+    AnyOf<(&'a SphericalJoint, &'a RevoluteJoint, &'a FixedJoint)>,
+    &'a mut JointImpulse,
+);
+
+type BodyItem<'a> = (
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    Option<&'a Mass>,
+    Option<&'a Inertia>,
+    Option<&'a mut LinearVelocity>,
+    Option<&'a mut AngularMomentum>,
+    Option<&'a mut AngularVelocity>,
+    Has<Sleeping>,
+);
+
+type Joints<'w, 's> = Query<'w, 's, JointItem<'static>, Without<Quarantined>>;
+type Bodies<'w, 's> = Query<'w, 's, BodyItem<'static>, Without<Quarantined>>;
+
+/// Joints act between the velocity and the position half of the substep, so the integrators
+/// must not fuse the two (the contacts' preparation sets the flag for contacts; this runs
+/// after it).
+fn mark_constraints_active(mut active: ResMut<ConstraintsActive>) {
+    active.0 = true;
+}
+
+/// Warm start, then one biased pass over every joint.
+fn solve_joints(
+    time: Res<SubstepTime>,
+    settings: Res<JointSettings>,
+    mut joints: Joints,
+    mut bodies: Bodies,
+) {
+    let hertz = settings.hertz.min(0.25 / time.h);
+    let soft = crate::collision::solver::Softness::new(hertz, settings.damping_ratio, time.h);
+    pass(&mut joints, &mut bodies, Mode::soft(soft), true, time.h);
+}
+
+/// One rigid pass over every joint.
+fn relax_joints(time: Res<SubstepTime>, mut joints: Joints, mut bodies: Bodies) {
+    pass(&mut joints, &mut bodies, Mode::RIGID, false, time.h);
+}
+
+/// The joint's sides and rows.
+fn describe(
+    joint: (
+        Option<&SphericalJoint>,
+        Option<&RevoluteJoint>,
+        Option<&FixedJoint>,
+    ),
+) -> (JointBodies, Angular) {
+    match joint {
+        (Some(j), _, _) => (j.bodies, Angular::Free),
+        (_, Some(j), _) => (
+            j.bodies,
+            Angular::Hinge {
+                axis_a: j.axis_a,
+                axis_b: j.axis_b,
+            },
+        ),
+        (_, _, Some(j)) => (
+            j.bodies,
+            Angular::Weld {
+                relative: j.relative,
+            },
+        ),
+        // `AnyOf` holds at least one.
+        (None, None, None) => unreachable!("AnyOf matched no joint kind"),
+    }
+}
+
+/// A body's side: immovable when it has no mass, is asleep or is not a body at all (the
+/// world), with its anchor measured from its centre of mass.
+fn load(bodies: &Bodies, e: Option<Entity>, anchor: Vec3) -> (Side, Vec3A) {
+    let Some((x, q, com, mass, inertia, v, l, w, asleep)) = e.and_then(|e| bodies.get(e).ok())
+    else {
+        return (Side::WORLD, Vec3A::from(anchor));
+    };
+    let local = Vec3A::from(anchor - com.map_or(Vec3::ZERO, |c| c.0));
+    let mut side = Side {
+        x: x.0,
+        q: q.0,
+        ..Side::WORLD
+    };
+    if asleep {
+        return (side, local);
+    }
+    side.moves = mass.is_some_and(|m| m.inverse() > 0.0);
+    side.v = v.map_or(Vec3A::ZERO, |v| v.0);
+    side.inv_m = mass.map_or(0.0, Mass::inverse);
+    match (inertia, l) {
+        (Some(i), Some(l)) if !i.is_infinite() => {
+            side.w = i.angular_velocity(q.0, l.0);
+            side.inv_i = i.world_inverse_tensor(q.0).into();
+        }
+        _ => side.w = w.map_or(Vec3A::ZERO, |w| w.0),
+    }
+    (side, local)
+}
+
+/// Writes a moving side's velocities back: v, and L += the pass's angular impulse with ω
+/// following it.
+fn store(bodies: &mut Bodies, e: Option<Entity>, side: &Side) {
+    if !side.moves {
+        return;
+    }
+    let Some((_, q, _, _, inertia, v, l, w, _)) = e.and_then(|e| bodies.get_mut(e).ok()) else {
+        return;
+    };
+    if let Some(mut v) = v {
+        v.0 = side.v;
+    }
+    if let (Some(mut l), Some(i)) = (l, inertia) {
+        let l = l.bypass_change_detection();
+        l.0 += side.dl;
+        if let Some(mut w) = w {
+            w.bypass_change_detection().0 = i.angular_velocity(q.0, l.0);
+        }
+    }
+}
+
+fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32) {
+    for (joint, mut impulse) in joints.iter_mut() {
+        let (ends, angular) = describe(joint);
+        let (mut a, local_a) = load(bodies, ends.a, ends.anchor_a);
+        let (mut b, local_b) = load(bodies, Some(ends.b), ends.anchor_b);
+        let rows = Rows {
+            local_a,
+            local_b,
+            angular,
+        };
+        let mut acc = Accumulated {
+            linear: impulse.linear.into(),
+            angular: impulse.angular.into(),
+        };
+        if warm {
+            solve::warm_start(&rows, &acc, &mut a, &mut b);
+        }
+        solve::solve(&rows, &mut acc, mode, &mut a, &mut b);
+        store(bodies, ends.a, &a);
+        store(bodies, Some(ends.b), &b);
+        // Bookkeeping, not a change anyone listens for.
+        let impulse = impulse.bypass_change_detection();
+        impulse.linear = acc.linear.into();
+        impulse.angular = acc.angular.into();
+        impulse.h = h;
+    }
+}

@@ -1,0 +1,3 @@
+//! Joints against closed forms, at the defaults.
+
+mod pendulums;
