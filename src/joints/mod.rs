@@ -50,6 +50,7 @@
 //! assert!((force.y - 98.1).abs() < 0.5, "{force}");
 //! ```
 
+mod block;
 mod plugin;
 mod solve;
 

@@ -4,6 +4,9 @@
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 
+use bevy_platform::collections::HashMap;
+
+use super::block::{self, Row};
 use super::solve::{self, Accumulated, Angular, Mode, Rows, Side};
 use super::{FixedJoint, JointBodies, JointImpulse, JointSettings, RevoluteJoint, SphericalJoint};
 use crate::core::plugin::WorldPlugin;
@@ -89,15 +92,35 @@ fn solve_joints(
     settings: Res<JointSettings>,
     mut joints: Joints,
     mut bodies: Bodies,
+    mut scratch: Local<Scratch>,
 ) {
     let hertz = settings.hertz.min(0.25 / time.h);
     let soft = crate::collision::solver::Softness::new(hertz, settings.damping_ratio, time.h);
-    pass(&mut joints, &mut bodies, Mode::soft(soft), true, time.h);
+    pass(
+        &mut joints,
+        &mut bodies,
+        Mode::soft(soft),
+        true,
+        time.h,
+        &mut scratch,
+    );
 }
 
 /// One rigid pass over every joint.
-fn relax_joints(time: Res<SubstepTime>, mut joints: Joints, mut bodies: Bodies) {
-    pass(&mut joints, &mut bodies, Mode::RIGID, false, time.h);
+fn relax_joints(
+    time: Res<SubstepTime>,
+    mut joints: Joints,
+    mut bodies: Bodies,
+    mut scratch: Local<Scratch>,
+) {
+    pass(
+        &mut joints,
+        &mut bodies,
+        Mode::RIGID,
+        false,
+        time.h,
+        &mut scratch,
+    );
 }
 
 /// The joint's sides and rows.
@@ -178,30 +201,149 @@ fn store(bodies: &mut Bodies, e: Option<Entity>, side: &Side) {
     }
 }
 
-fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32) {
-    for (joint, mut impulse) in joints.iter_mut() {
+/// A pass's working set, kept to reuse its memory.
+#[derive(Default)]
+struct Scratch {
+    /// Every side the pass reads: each moving body once, then immovable sides per joint.
+    sides: Vec<Side>,
+    entities: Vec<Option<Entity>>,
+    index: HashMap<Entity, usize>,
+    /// Per joint: its geometry and its sides' places in `sides`.
+    joints: Vec<(Rows, usize, usize)>,
+    acc: Vec<Accumulated>,
+    /// Union–find over `sides`: the groups of bodies joints connect.
+    parent: Vec<usize>,
+    /// Per joint, its group's root; then the joints in group order.
+    order: Vec<(usize, usize)>,
+    rows: Vec<Row>,
+    matrix: Vec<f64>,
+}
+
+fn root(parent: &mut [usize], mut i: usize) -> usize {
+    while parent[i] != i {
+        parent[i] = parent[parent[i]];
+        i = parent[i];
+    }
+    i
+}
+
+/// The place of `e`'s side in `s.sides`, loading it the first time; immovable sides get a
+/// place of their own each time.
+fn place(s: &mut Scratch, bodies: &Bodies, e: Option<Entity>, anchor: Vec3) -> (usize, Vec3A) {
+    if let Some(&i) = e.and_then(|e| s.index.get(&e)) {
+        let com = e
+            .and_then(|e| bodies.get(e).ok())
+            .and_then(|b| b.2)
+            .map_or(Vec3::ZERO, |c| c.0);
+        return (i, Vec3A::from(anchor - com));
+    }
+    let (side, local) = load(bodies, e, anchor);
+    let i = s.sides.len();
+    if side.moves
+        && let Some(e) = e
+    {
+        s.index.insert(e, i);
+    }
+    s.sides.push(side);
+    s.entities.push(e);
+    (i, local)
+}
+
+/// One pass over every joint: the warm start first when `warm`; then each group of joints
+/// connected through moving bodies is solved as one system (up to
+/// [`block::MAX_GROUP_ROWS`] rows), or joint after joint when larger.
+fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32, s: &mut Scratch) {
+    s.sides.clear();
+    s.entities.clear();
+    s.index.clear();
+    s.joints.clear();
+    s.acc.clear();
+    for (joint, impulse) in joints.iter() {
         let (ends, angular) = describe(joint);
-        let (mut a, local_a) = load(bodies, ends.a, ends.anchor_a);
-        let (mut b, local_b) = load(bodies, Some(ends.b), ends.anchor_b);
+        let (ia, local_a) = place(s, bodies, ends.a, ends.anchor_a);
+        let (ib, local_b) = place(s, bodies, Some(ends.b), ends.anchor_b);
         let rows = Rows {
             local_a,
             local_b,
             angular,
         };
-        let mut acc = Accumulated {
+        s.joints.push((rows, ia, ib));
+        s.acc.push(Accumulated {
             linear: impulse.linear.into(),
             angular: impulse.angular.into(),
-        };
-        if warm {
-            solve::warm_start(&rows, &acc, &mut a, &mut b);
+        });
+    }
+    if warm {
+        for (j, &(rows, ia, ib)) in s.joints.iter().enumerate() {
+            if let Ok([a, b]) = s.sides.get_disjoint_mut([ia, ib]) {
+                solve::warm_start(&rows, &s.acc[j], a, b);
+            }
         }
-        solve::solve(&rows, &mut acc, mode, &mut a, &mut b);
-        store(bodies, ends.a, &a);
-        store(bodies, Some(ends.b), &b);
+    }
+    // Groups: bodies joined through moving bodies (an immovable side joins nothing).
+    s.parent.clear();
+    s.parent.extend(0..s.sides.len());
+    for &(_, ia, ib) in &s.joints {
+        if s.sides[ia].moves && s.sides[ib].moves {
+            let (ra, rb) = (root(&mut s.parent, ia), root(&mut s.parent, ib));
+            s.parent[ra.max(rb)] = ra.min(rb);
+        }
+    }
+    s.order.clear();
+    for (j, &(_, ia, ib)) in s.joints.iter().enumerate() {
+        let moving = if s.sides[ib].moves { ib } else { ia };
+        if s.sides[moving].moves {
+            s.order.push((root(&mut s.parent, moving), j));
+        }
+    }
+    // Groups in the order of their first joint, joints in their own order within a group.
+    let mut first = HashMap::<usize, usize>::new();
+    for &(g, j) in &s.order {
+        first.entry(g).or_insert(j);
+    }
+    s.order.sort_by_key(|&(g, j)| (first[&g], j));
+    let mut k = 0;
+    while k < s.order.len() {
+        let group = s.order[k].0;
+        let end = k + s.order[k..].iter().take_while(|o| o.0 == group).count();
+        s.rows.clear();
+        for i in k..end {
+            let j = s.order[i].1;
+            push_rows(s, j);
+        }
+        if s.rows.len() <= block::MAX_GROUP_ROWS {
+            block::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.matrix);
+        } else {
+            for i in k..end {
+                let j = s.order[i].1;
+                s.rows.clear();
+                push_rows(s, j);
+                block::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.matrix);
+            }
+        }
+        k = end;
+    }
+    for (side, &e) in s.sides.iter().zip(&s.entities) {
+        store(bodies, e, side);
+    }
+    for ((_, mut impulse), acc) in joints.iter_mut().zip(&s.acc) {
         // Bookkeeping, not a change anyone listens for.
         let impulse = impulse.bypass_change_detection();
         impulse.linear = acc.linear.into();
         impulse.angular = acc.angular.into();
         impulse.h = h;
     }
+}
+
+/// Appends joint `j`'s rows to `s.rows`, each side named only if it moves.
+fn push_rows(s: &mut Scratch, j: usize) {
+    let (rows, ia, ib) = s.joints[j];
+    let moving = |i: usize| s.sides[i].moves.then_some(i);
+    block::joint_rows(
+        j,
+        &rows,
+        (moving(ia), &s.sides[ia]),
+        (moving(ib), &s.sides[ib]),
+        &mut s.rows,
+    );
 }

@@ -1,3 +1,4 @@
 //! Joints against closed forms, at the defaults.
 
+mod hard_cases;
 mod pendulums;

@@ -1,0 +1,225 @@
+//! Joints under loads that break naive solvers, at the defaults.
+
+use bevy_ecs::prelude::*;
+use hooke::prelude::*;
+
+use crate::common::default_world;
+
+/// A joint as the tests build it: side a (or the world), side b, and their anchors.
+type Joined = (Option<Entity>, Entity, Vec3, Vec3);
+
+/// Steps `world` 5 s and returns the widest any of `joints` parted (m); none of `bodies`
+/// may be quarantined.
+fn widest_parting(world: &mut World, joints: &[Joined], bodies: &[Entity]) -> f32 {
+    let point = |world: &World, e: Option<Entity>, local: Vec3| -> Vec3A {
+        e.map_or(local.into(), |e| {
+            world.get::<Position>(e).unwrap().0
+                + world.get::<Rotation>(e).unwrap().0 * Vec3A::from(local)
+        })
+    };
+    let mut peak = 0.0_f32;
+    for _ in 0..300 {
+        world.step_physics();
+        for &(a, b, la, lb) in joints {
+            peak = peak.max((point(world, a, la) - point(world, Some(b), lb)).length());
+        }
+    }
+    for &e in bodies {
+        assert!(world.get::<Quarantined>(e).is_none());
+    }
+    peak
+}
+
+/// Balls in rapier's 1:1000 chain, the first fixed.
+const COUNT: usize = 17;
+
+/// One ball of rapier's 1:1000 chain: its radius and place along z, and its joint's anchor
+/// offsets (m): `shift1` on the light ball before it, `shift2` on itself.
+struct Link {
+    ball: f32,
+    z: f32,
+    shift1: f32,
+    shift2: f32,
+}
+
+/// Ball `i` of the chain, as rapier's scene lays it out.
+fn link(i: usize) -> Link {
+    let rad = 0.2_f32;
+    let ball = if i == COUNT - 1 { rad * 10.0 } else { rad };
+    let (shift1, shift2) = (rad * 1.1, ball + rad * 0.1);
+    let z = if i == 0 {
+        0.0
+    } else {
+        (i as f32 - 1.0) * 2.0 * shift1 + shift1 + shift2
+    };
+    Link {
+        ball,
+        z,
+        shift1,
+        shift2,
+    }
+}
+
+/// rapier's `debug_chain_high_mass_ratio3` scene (its regression test
+/// `substep_chain_high_mass_ratio`): a fixed ball, 15 light balls of radius 0.2 m and one of
+/// radius 2 m (1,000 times the mass) on ball joints, laid out horizontally along z and let
+/// swing down. Returns the widest any joint's anchors parted over 5 s (m).
+fn hooke_heavy_chain() -> f32 {
+    let mut world = default_world();
+    let mut bodies: Vec<Entity> = Vec::new();
+    let mut joints: Vec<Joined> = Vec::new();
+    for i in 0..COUNT {
+        let Link {
+            ball,
+            z,
+            shift1,
+            shift2,
+        } = link(i);
+        let kind = if i == 0 {
+            RigidBody::Static
+        } else {
+            RigidBody::Dynamic
+        };
+        let e = world
+            .spawn((
+                kind,
+                Collider::ball(ball).unwrap(),
+                Position(Vec3A::new(0.0, 0.0, z)),
+                hooke::core::rest::SleepingDisabled,
+            ))
+            .id();
+        if i > 0 {
+            let (a, anchors) = if i == 1 {
+                // The fixed ball is the world: its anchor, its centre, a world point.
+                (None, (Vec3::ZERO, Vec3::new(0.0, 0.0, -2.0 * shift1)))
+            } else {
+                (
+                    Some(bodies[i - 1]),
+                    (Vec3::new(0.0, 0.0, shift1), Vec3::new(0.0, 0.0, -shift2)),
+                )
+            };
+            let joint = match a {
+                None => SphericalJoint::to_world(e),
+                Some(a) => SphericalJoint::new(a, e),
+            };
+            world.spawn(joint.with_anchors(anchors.0, anchors.1));
+            joints.push((a, e, anchors.0, anchors.1));
+        }
+        bodies.push(e);
+    }
+    widest_parting(&mut world, &joints, &bodies)
+}
+
+/// The same scene in rapier 0.36 at its defaults (its test's baseline).
+fn rapier_heavy_chain() -> f32 {
+    use rapier3d::prelude as rp;
+    let mut world = rp::PhysicsWorld::new();
+    let mut prev = None;
+    for i in 0..COUNT {
+        let Link {
+            ball,
+            z,
+            shift1,
+            shift2,
+        } = link(i);
+        let kind = if i == 0 {
+            rp::RigidBodyType::Fixed
+        } else {
+            rp::RigidBodyType::Dynamic
+        };
+        let (e, _) = world.insert(
+            rp::RigidBodyBuilder::new(kind)
+                .translation(rp::Vector::new(0.0, 0.0, z))
+                .can_sleep(false),
+            rp::ColliderBuilder::ball(ball),
+        );
+        if let Some(p) = prev {
+            let joint = if i == 1 {
+                rp::SphericalJointBuilder::new().local_anchor2(rp::Vector::new(
+                    0.0,
+                    0.0,
+                    -shift1 * 2.0,
+                ))
+            } else {
+                rp::SphericalJointBuilder::new()
+                    .local_anchor1(rp::Vector::new(0.0, 0.0, shift1))
+                    .local_anchor2(rp::Vector::new(0.0, 0.0, -shift2))
+            };
+            world.insert_impulse_joint(p, e, joint);
+        }
+        prev = Some(e);
+    }
+    let mut peak = 0.0_f32;
+    for _ in 0..300 {
+        world.step();
+        for (_, joint) in world.impulse_joints() {
+            let (b1, b2) = (&world.bodies[joint.body1()], &world.bodies[joint.body2()]);
+            let a1 = b1.position() * joint.data.local_frame1.translation;
+            let a2 = b2.position() * joint.data.local_frame2.translation;
+            peak = peak.max((a1 - a2).length());
+        }
+    }
+    peak
+}
+
+#[test]
+fn a_chain_holding_a_ball_a_thousand_times_heavier_parts_no_more_than_rapiers() {
+    // Measured over 5 s at the defaults: hooke's anchors part by up to 5.85 m, rapier 0.36's
+    // by 8.65 m: neither engine holds this chain. Its joints are solved as one system (the
+    // velocities hold exactly after each relax pass), but the light links spin so fast that
+    // a substep's turn carries their anchors apart; the goal of 1 cm needs a correction at
+    // the position level (docs/joints.md).
+    let ours = hooke_heavy_chain();
+    let theirs = rapier_heavy_chain();
+    assert!(
+        ours.is_finite() && ours <= theirs,
+        "hooke {ours} m, rapier 0.36 {theirs} m"
+    );
+}
+
+#[test]
+fn a_hundred_link_chain_holding_a_load_stays_within_three_centimetres() {
+    // 100 links of 0.1 × 0.2 × 0.1 m (2 kg) hanging from the world with an 8 kg box of 2 dm
+    // at the bottom, the box kicked sideways at 3 m/s. Too many rows for one system (300):
+    // solved joint after joint. Measured: the anchors part by up to 2.4 cm over 5 s, over
+    // the goal of 1 cm (docs/joints.md); bounded here so that it cannot grow unseen.
+    let mut world = default_world();
+    let top = Vec3::new(0.0, 25.0, 0.0);
+    let link = Vec3::new(0.05, 0.1, 0.05);
+    let mut above = None;
+    let mut joints = Vec::new();
+    let mut bodies = Vec::new();
+    for k in 0..101 {
+        let half = if k == 100 {
+            Vec3::new(0.1, 0.1, 0.1)
+        } else {
+            link
+        };
+        let y = top.y - 2.0 * link.y * k as f32 - half.y;
+        let collider = Collider::cuboid(half.x, half.y, half.z).unwrap();
+        let e = world
+            .spawn((
+                RigidBody::Dynamic,
+                collider,
+                Position(Vec3A::new(0.0, y, 0.0)),
+            ))
+            .id();
+        let (a, anchor_a) = match above {
+            None => (None, top),
+            Some(up) => (Some(up), Vec3::new(0.0, -link.y, 0.0)),
+        };
+        let anchor_b = Vec3::new(0.0, half.y, 0.0);
+        let joint = match a {
+            None => SphericalJoint::to_world(e),
+            Some(a) => SphericalJoint::new(a, e),
+        };
+        world.spawn(joint.with_anchors(anchor_a, anchor_b));
+        joints.push((a, e, anchor_a, anchor_b));
+        above = Some(e);
+        bodies.push(e);
+    }
+    // A sideways kick to the load, so the chain swings.
+    world.get_mut::<LinearVelocity>(bodies[100]).unwrap().0 = Vec3A::new(3.0, 0.0, 0.0);
+    let peak = widest_parting(&mut world, &joints, &bodies);
+    assert!(peak < 0.03, "anchors parted {peak} m");
+}
