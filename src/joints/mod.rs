@@ -10,8 +10,10 @@
 //! A joint is an entity of its own: spawn `RevoluteJoint::new(door, frame).with_anchors(..)`
 //! (or `::to_world(body)` for a body hinged to the world). Anchors are in each body's shape
 //! frame (m), the frame whose origin is `x − R c` ([`crate::rigid::CenterOfMass`]); a world
-//! side's anchor is a world point. A joint naming a missing, static or quarantined body
-//! treats that side as the immovable world; a joint with a non-finite or zero-length input
+//! side's anchor is a world point. A static, kinematic or sleeping side is held where it is
+//! and takes no impulse. A joint naming a body that is gone or quarantined is inert (its
+//! partner runs free, its [`JointImpulse`] reads zero) until the body is back; a joint with a
+//! bad input (a non-finite anchor, a hinge axis not of unit length, a body joined to itself)
 //! is quarantined on insert with an [`crate::Error`] saying which.
 //!
 //! **Solver.** Each substep, after the contacts' passes (see [`JointPlugin`]): the

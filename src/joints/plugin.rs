@@ -260,6 +260,22 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     s.acc.clear();
     for (joint, impulse) in joints.iter() {
         let (ends, angular) = describe(joint);
+        // A body that is gone or quarantined leaves the joint inert: its partner runs free
+        // (and the joint exerts nothing) until it is back.
+        let gone = |e: Entity| bodies.get(e).is_err();
+        if ends.a.is_some_and(gone) || gone(ends.b) {
+            let inert = s.sides.len();
+            s.sides.push(Side::WORLD);
+            s.entities.push(None);
+            let rows = Rows {
+                local_a: Vec3A::ZERO,
+                local_b: Vec3A::ZERO,
+                angular,
+            };
+            s.joints.push((rows, inert, inert));
+            s.acc.push(Accumulated::default());
+            continue;
+        }
         let (ia, local_a) = place(s, bodies, ends.a, ends.anchor_a);
         let (ib, local_b) = place(s, bodies, Some(ends.b), ends.anchor_b);
         let rows = Rows {

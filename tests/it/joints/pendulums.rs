@@ -321,3 +321,79 @@ fn joined_bodies_do_not_collide_unless_asked_to() {
         }
     }
 }
+
+#[test]
+fn a_quarantined_body_frees_its_partner_and_nothing_else_stops() {
+    // Two rods on ball joints; the upper one's velocity is written NaN mid-swing.
+    let mut world = default_world();
+    let pivot = Vec3::new(0.0, 3.0, 0.0);
+    let spawn_rod = |world: &mut World, k: usize| {
+        world
+            .spawn((
+                RigidBody::Dynamic,
+                Collider::cuboid(HALF.x, HALF.y, HALF.z).unwrap(),
+                Position(Vec3A::new(
+                    0.0,
+                    pivot.y - HALF.y - 2.0 * HALF.y * k as f32,
+                    0.0,
+                )),
+                LinearVelocity(Vec3A::new(1.0, 0.0, 0.0)),
+            ))
+            .id()
+    };
+    let (upper, lower) = (spawn_rod(&mut world, 0), spawn_rod(&mut world, 1));
+    world.spawn(SphericalJoint::to_world(upper).with_anchors(pivot, Vec3::Y * HALF.y));
+    let link = world
+        .spawn(SphericalJoint::new(upper, lower).with_anchors(-Vec3::Y * HALF.y, Vec3::Y * HALF.y))
+        .id();
+    for _ in 0..10 {
+        world.step_physics();
+    }
+    world.get_mut::<LinearVelocity>(upper).unwrap().0 = Vec3A::NAN;
+    world.step_physics();
+    assert!(world.get::<Quarantined>(upper).is_some());
+    let v0 = world.get::<LinearVelocity>(lower).unwrap().0;
+    for _ in 0..30 {
+        world.step_physics();
+    }
+    // The lower rod falls freely: its vertical speed grew by g t, and it is finite and live.
+    let v1 = world.get::<LinearVelocity>(lower).unwrap().0;
+    assert!(world.get::<Quarantined>(lower).is_none());
+    assert!(v1.is_finite());
+    assert!((v0.y - v1.y - 9.81 * 0.5).abs() < 1e-3, "{v0} then {v1}");
+    assert_eq!(world.get::<JointImpulse>(link).unwrap().force(), Vec3::ZERO);
+}
+
+#[test]
+fn a_joint_with_a_bad_input_is_quarantined_with_its_reason() {
+    let mut world = default_world();
+    let body = world
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::ball(0.5).unwrap(),
+            Position(Vec3A::ZERO),
+        ))
+        .id();
+    let mut bent = RevoluteJoint::to_world(body, Vec3::Z);
+    bent.axis_b = Vec3::new(0.0, 0.0, 2.0);
+    let cases = [
+        world.spawn(SphericalJoint::new(body, body)).id(),
+        world.spawn(bent).id(),
+        world
+            .spawn(FixedJoint::to_world(body, Quat::IDENTITY).with_anchors(Vec3::NAN, Vec3::ZERO))
+            .id(),
+    ];
+    world.step_physics();
+    let reasons: Vec<String> = cases
+        .iter()
+        .map(|&j| match &world.get::<Quarantined>(j).unwrap().reason {
+            QuarantineReason::InvalidInput(e) => e.to_string(),
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert!(reasons[0].contains("itself"), "{}", reasons[0]);
+    assert!(reasons[1].contains("hinge axis b"), "{}", reasons[1]);
+    assert!(reasons[2].contains("joint anchor a"), "{}", reasons[2]);
+    // The body itself runs on.
+    assert!(world.get::<Quarantined>(body).is_none());
+}
