@@ -71,6 +71,7 @@ use crate::collision::ContactStarted;
 use crate::core::plugin::PhysicsCorePlugin;
 use crate::core::quarantine::BodyQuarantined;
 use crate::core::time::PhysicsTime;
+use crate::joints::JointPlugin;
 use crate::particles::DampingPlugin;
 use crate::particles::GravityPlugin;
 use crate::particles::VelocityFieldPlugin;
@@ -205,6 +206,7 @@ bevy_plugin!(
     SpringPlugin,
     RigidBodyPlugin,
     CollisionPlugin,
+    JointPlugin,
     SleepPlugin,
     SoftBodyPlugin,
     ClothPlugin
@@ -224,6 +226,7 @@ impl PluginGroup for PhysicsPlugins {
             .add(SpringPlugin)
             .add(RigidBodyPlugin)
             .add(CollisionPlugin)
+            .add(JointPlugin)
             .add(SleepPlugin)
             .add(SoftBodyPlugin)
             .add(ClothPlugin)

@@ -485,3 +485,33 @@ fn despawning_mid_run_leaves_the_rest_running() {
         0
     );
 }
+
+#[test]
+fn a_door_hinged_in_an_app_swings_about_its_hinge() {
+    // `PhysicsPlugins` as a plugin group brings the joints: a 1 m door hinged at its left
+    // edge about the vertical, pushed at its free edge, turns and keeps its hinge in place.
+    let mut app = app(144.0);
+    let door = spawn(
+        &mut app,
+        (
+            RigidBody::Dynamic,
+            Collider::cuboid(0.5, 1.0, 0.05).unwrap(),
+            Transform::from_xyz(0.5, 1.5, 0.0),
+            GravityScale(0.0),
+            LinearVelocity(Vec3A::new(0.0, 0.0, 1.0)),
+        ),
+    );
+    spawn(
+        &mut app,
+        RevoluteJoint::to_world(door, Vec3::Y)
+            .with_anchors(Vec3::new(0.0, 1.5, 0.0), Vec3::new(-0.5, 0.0, 0.0)),
+    );
+    frames(&mut app, 144);
+    let t = app.world().get::<Transform>(door).unwrap();
+    let hinge = t.translation + t.rotation * Vec3::new(-0.5, 0.0, 0.0);
+    assert!(hinge.distance(Vec3::new(0.0, 1.5, 0.0)) < 0.01, "{hinge}");
+    // It turned about y (away from its start), and only about y.
+    let (axis, angle) = t.rotation.to_axis_angle();
+    assert!(angle > 0.5, "turned {angle} rad");
+    assert!(axis.y.abs() > 0.999, "about {axis}");
+}
