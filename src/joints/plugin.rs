@@ -130,24 +130,24 @@ fn describe(
         Option<&RevoluteJoint>,
         Option<&FixedJoint>,
     ),
-) -> (JointBodies, Angular) {
+) -> Option<(JointBodies, Angular)> {
     match joint {
-        (Some(j), _, _) => (j.bodies, Angular::Free),
-        (_, Some(j), _) => (
+        (Some(j), _, _) => Some((j.bodies, Angular::Free)),
+        (_, Some(j), _) => Some((
             j.bodies,
             Angular::Hinge {
                 axis_a: j.axis_a,
                 axis_b: j.axis_b,
             },
-        ),
-        (_, _, Some(j)) => (
+        )),
+        (_, _, Some(j)) => Some((
             j.bodies,
             Angular::Weld {
                 relative: j.relative,
             },
-        ),
-        // `AnyOf` holds at least one.
-        (None, None, None) => unreachable!("AnyOf matched no joint kind"),
+        )),
+        // `AnyOf` holds at least one; were it to hold none, the joint is inert.
+        (None, None, None) => None,
     }
 }
 
@@ -217,6 +217,8 @@ struct Scratch {
     order: Vec<(usize, usize)>,
     rows: Vec<Row>,
     matrix: Vec<f64>,
+    /// Per group root, its first joint (groups are solved in that order).
+    first: HashMap<usize, usize>,
 }
 
 fn root(parent: &mut [usize], mut i: usize) -> usize {
@@ -259,23 +261,24 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     s.joints.clear();
     s.acc.clear();
     for (joint, impulse) in joints.iter() {
-        let (ends, angular) = describe(joint);
         // A body that is gone or quarantined leaves the joint inert: its partner runs free
         // (and the joint exerts nothing) until it is back.
         let gone = |e: Entity| bodies.get(e).is_err();
-        if ends.a.is_some_and(gone) || gone(ends.b) {
+        let described =
+            describe(joint).filter(|(ends, _)| !(ends.a.is_some_and(gone) || gone(ends.b)));
+        let Some((ends, angular)) = described else {
             let inert = s.sides.len();
             s.sides.push(Side::WORLD);
             s.entities.push(None);
             let rows = Rows {
                 local_a: Vec3A::ZERO,
                 local_b: Vec3A::ZERO,
-                angular,
+                angular: Angular::Free,
             };
             s.joints.push((rows, inert, inert));
             s.acc.push(Accumulated::default());
             continue;
-        }
+        };
         let (ia, local_a) = place(s, bodies, ends.a, ends.anchor_a);
         let (ib, local_b) = place(s, bodies, Some(ends.b), ends.anchor_b);
         let rows = Rows {
@@ -313,10 +316,11 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
         }
     }
     // Groups in the order of their first joint, joints in their own order within a group.
-    let mut first = HashMap::<usize, usize>::new();
+    s.first.clear();
     for &(g, j) in &s.order {
-        first.entry(g).or_insert(j);
+        s.first.entry(g).or_insert(j);
     }
+    let first = &s.first;
     s.order.sort_by_key(|&(g, j)| (first[&g], j));
     let mut k = 0;
     while k < s.order.len() {
