@@ -205,6 +205,7 @@ pub mod prelude {
     pub use crate::integrator::Integrator;
     pub use crate::integrator::IntegratorOverride;
     pub use crate::joints::FixedJoint;
+    pub use crate::joints::JointDiagnostics;
     pub use crate::joints::JointImpulse;
     pub use crate::joints::RevoluteJoint;
     pub use crate::joints::SphericalJoint;

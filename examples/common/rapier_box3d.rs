@@ -5,7 +5,7 @@
 //! sleeping as the scene says. The same cuboids and the same hull points as hooke's.
 #![allow(dead_code)]
 
-use hooke::tools::box3d::{FRICTION, Scene, SceneBodies};
+use hooke::tools::box3d::{FRICTION, JointGridSpec, Scene, SceneBodies};
 use rapier3d::prelude as rp;
 
 /// A rapier world holding `bodies` of `scene`; returns it and the dynamic bodies' handles.
@@ -35,6 +35,7 @@ pub fn rapier_scene(
         if !fixed {
             handles.push(h);
         }
+        h
     };
     match bodies {
         SceneBodies::Boxes(specs) => {
@@ -50,6 +51,28 @@ pub fn rapier_scene(
             let hull = rp::ColliderBuilder::convex_hull(&pile.points).expect("a valid hull");
             for &at in &pile.positions {
                 put(&mut world, hull.clone(), at, false);
+            }
+        }
+        SceneBodies::JointGrid(grid) => {
+            // Box3D's filter: category 2, colliding with everything but category 2.
+            let groups = rp::InteractionGroups::new(
+                rp::Group::GROUP_2,
+                !rp::Group::GROUP_2,
+                rp::InteractionTestMode::And,
+            );
+            let spheres: Vec<_> = (0..grid.side * grid.side)
+                .map(|index| {
+                    let (at, fixed) = grid.sphere(index);
+                    let c =
+                        rp::ColliderBuilder::ball(JointGridSpec::RADIUS).collision_groups(groups);
+                    put(&mut world, c, at, fixed)
+                })
+                .collect();
+            for (a, b, anchor_a, anchor_b) in grid.joints() {
+                let joint = rp::SphericalJointBuilder::new()
+                    .local_anchor1(anchor_a)
+                    .local_anchor2(anchor_b);
+                world.insert_impulse_joint(spheres[a], spheres[b], joint);
             }
         }
         SceneBodies::Washer(washer) => {

@@ -13,6 +13,7 @@ use crate::timing::{line, mean_step_time, median};
 fn scene_line(scene: Scene, small: bool, runs: usize, steps: usize) {
     let (mut a, mut b) = (Vec::new(), Vec::new());
     let (mut top_a, mut top_b) = (0.0f32, 0.0f32);
+    let (mut gap_a, mut gap_b) = (0.0f32, 0.0f32);
     for _ in 0..runs {
         let (mut w, bodies) = box3d::build(scene, small).unwrap();
         a.push(1e9 * mean_step_time(|| w.step_physics(), steps));
@@ -20,6 +21,7 @@ fn scene_line(scene: Scene, small: bool, runs: usize, steps: usize) {
             .iter()
             .map(|&e| w.get::<Position>(e).unwrap().get().y)
             .fold(f32::NEG_INFINITY, f32::max);
+        gap_a = w.resource::<JointDiagnostics>().largest_gap;
         drop(w);
         let (mut r, handles) = rapier_scene(scene, &scene.bodies(small));
         b.push(1e9 * mean_step_time(|| r.step(), steps));
@@ -27,14 +29,33 @@ fn scene_line(scene: Scene, small: bool, runs: usize, steps: usize) {
             .iter()
             .map(|&h| r.bodies[h].translation().y)
             .fold(f32::NEG_INFINITY, f32::max);
+        gap_b = r
+            .impulse_joints
+            .iter()
+            .map(|(_, j)| {
+                let (b1, b2) = (&r.bodies[j.body1()], &r.bodies[j.body2()]);
+                let a1 = b1.position() * j.data.local_frame1.translation;
+                let a2 = b2.position() * j.data.local_frame2.translation;
+                (a1 - a2).length()
+            })
+            .fold(0.0, f32::max);
     }
+    let gaps = if gap_a > 0.0 || gap_b > 0.0 {
+        format!(
+            "; widest joint gap at the end: hooke {:.2} mm, rapier {:.2} mm",
+            1e3 * gap_a,
+            1e3 * gap_b
+        )
+    } else {
+        String::new()
+    };
     let size = if small { "_small" } else { "" };
     line(
         &format!("box3d_{}{size}_vs_rapier", scene.name()),
         median(a),
         median(b),
         &format!(
-            "{steps} steps, {runs} runs; highest body at the end: hooke {top_a:.2} m, rapier {top_b:.2} m"
+            "{steps} steps, {runs} runs; highest body at the end: hooke {top_a:.2} m, rapier {top_b:.2} m{gaps}"
         ),
     );
 }

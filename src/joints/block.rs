@@ -106,7 +106,7 @@ pub(super) fn joint_rows(
 
 /// M⁻¹ Jᵀ of a row on one side: the velocity change per unit impulse.
 #[inline]
-fn response(side: &Side, lin: Vec3A, ang: Vec3A) -> (Vec3A, Vec3A) {
+pub(super) fn response(side: &Side, lin: Vec3A, ang: Vec3A) -> (Vec3A, Vec3A) {
     (side.inv_m * lin, side.inv_i * ang)
 }
 
@@ -143,16 +143,34 @@ pub(super) fn solve(
                 }
             }
         }
-        let speed = |body: Option<usize>, lin: Vec3A, ang: Vec3A| {
-            body.map_or(0.0, |s| lin.dot(bodies[s].v) + ang.dot(bodies[s].w))
-        };
-        let cdot = speed(rp.a, rp.lin_a, rp.ang_a) + speed(rp.b, rp.lin_b, rp.ang_b);
-        rhs[p] = f64::from(-mode.mass_scale * (cdot + mode.bias_rate * rp.c));
+        rhs[p] = target(rp, bodies, mode);
     }
     if !cholesky_solve(a, rhs, n) {
         return;
     }
-    for (rp, &x) in rows.iter().zip(rhs.iter()) {
+    apply(rows, rhs, bodies, acc, mode);
+}
+
+/// The right-hand side of row `rp`: −S_m (Ċ + β C).
+pub(super) fn target(rp: &Row, bodies: &[Side], mode: Mode) -> f64 {
+    let speed = |body: Option<usize>, lin: Vec3A, ang: Vec3A| {
+        body.map_or(0.0, |s| lin.dot(bodies[s].v) + ang.dot(bodies[s].w))
+    };
+    let cdot = speed(rp.a, rp.lin_a, rp.ang_a) + speed(rp.b, rp.lin_b, rp.ang_b);
+    f64::from(-mode.mass_scale * (cdot + mode.bias_rate * rp.c))
+}
+
+/// Applies the solution `x` of A x = b to the rows' bodies: λ = x − S_i (the row's share of
+/// the accumulated impulse), added to the joints' accumulators.
+pub(super) fn apply(
+    rows: &[Row],
+    x: &[f64],
+    bodies: &mut [Side],
+    acc: &mut [Accumulated],
+    mode: Mode,
+) {
+    let sides = |r: &Row| [(r.a, r.lin_a, r.ang_a), (r.b, r.lin_b, r.ang_b)];
+    for (rp, &x) in rows.iter().zip(x.iter()) {
         let held = if rp.linear {
             acc[rp.joint].linear
         } else {
@@ -289,6 +307,45 @@ mod tests {
             (after - momentum).length() < 1e-5,
             "{after} against {momentum}"
         );
+    }
+
+    #[test]
+    fn a_ball_joint_alone_is_solved_as_its_rows_are() {
+        let geometry = Rows {
+            local_a: Vec3A::new(0.5, 0.1, 0.0),
+            local_b: Vec3A::new(-0.4, 0.0, 0.2),
+            angular: Angular::Free,
+        };
+        let mut sides = vec![body(Vec3A::ZERO), body(Vec3A::new(0.9, 0.2, -0.1))];
+        sides[0].v = Vec3A::new(0.0, 1.0, 0.0);
+        sides[1].w = Vec3A::new(0.3, -2.0, 0.7);
+        sides[1].inv_m = 0.25;
+        let mode = Mode {
+            bias_rate: 20.0,
+            mass_scale: 0.9,
+            impulse_scale: 0.1,
+        };
+        let start = Accumulated {
+            linear: Vec3A::new(0.2, -0.1, 0.3),
+            angular: Vec3A::ZERO,
+        };
+        let mut rows = Vec::new();
+        joint_rows(
+            0,
+            &geometry,
+            (Some(0), &sides[0]),
+            (Some(1), &sides[1]),
+            &mut rows,
+        );
+        let (mut dense, mut acc_dense) = (sides.clone(), vec![start]);
+        solve(&rows, &mut dense, &mut acc_dense, mode, &mut Vec::new());
+        let mut acc = start;
+        let [a, b] = sides.get_disjoint_mut([0, 1]).unwrap();
+        super::super::solve::solve_ball(&geometry, a, b, &mut acc, mode);
+        assert!((acc.linear - acc_dense[0].linear).length() < 1e-4);
+        for (d, s) in dense.iter().zip(&sides) {
+            assert!((d.v - s.v).length() < 1e-4 && (d.w - s.w).length() < 1e-4);
+        }
     }
 
     #[test]

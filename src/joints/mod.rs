@@ -21,7 +21,11 @@
 //! together as a spring of [`JointSettings::hertz`] and damping ratio
 //! [`JointSettings::damping_ratio`] would (Box2D v3's soft step), then, after the positions
 //! move, one pass without bias removes the anchors' relative velocity. The relax pass is
-//! rigid, so the soft bias adds no energy to the motion it leaves.
+//! rigid, so the soft bias adds no energy to the motion it leaves. Joints connected through
+//! moving bodies are solved as one system (dense up to 96 rows, a tree in linear time past
+//! that; a net of loops joint after joint), and each pass turns a jointed body with its
+//! inertia stiffened by its joints' pull (see `solve.rs`), which keeps light links under
+//! heavy loads in line. [`JointDiagnostics`] reports how well the joints hold.
 //!
 //! [`JointImpulse`] (required by every joint) holds the impulse of the last substep; its
 //! [`JointImpulse::force`] and [`JointImpulse::torque`] are the joint's force and torque.
@@ -53,9 +57,12 @@
 //! ```
 
 mod block;
+mod diagnostics;
 mod plugin;
 mod solve;
+mod tree;
 
+pub use diagnostics::JointDiagnostics;
 pub use plugin::JointPlugin;
 
 use bevy_ecs::prelude::*;

@@ -2,19 +2,21 @@
 //! contacts' relax pass, each substep.
 
 use bevy_ecs::prelude::*;
-use glam::{Vec3, Vec3A};
+use glam::{Mat3A, Vec3, Vec3A};
 
 use bevy_platform::collections::HashMap;
 
 use super::block::{self, Row};
 use super::solve::{self, Accumulated, Angular, Mode, Rows, Side};
+use super::tree::{self, TreeScratch};
 use super::{FixedJoint, JointBodies, JointImpulse, JointSettings, RevoluteJoint, SphericalJoint};
+use crate::core::diagnostics::energy_on;
 use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::Quarantined;
 use crate::core::rest::Sleeping;
 use crate::core::schedule::{
-    CollisionSystems, PhysicsSchedule, PrepareSystems, RelaxSystems, StepSystems, SubstepSchedule,
-    add_own_systems,
+    CollisionSystems, MeasureSystems, PhysicsSchedule, PrepareSystems, RelaxSystems, StepSystems,
+    SubstepSchedule, add_own_systems,
 };
 use crate::core::time::SubstepTime;
 use crate::integrator::ConstraintsActive;
@@ -28,7 +30,17 @@ pub struct JointPlugin;
 
 impl WorldPlugin for JointPlugin {
     fn build(&self, world: &mut World) {
+        add_own_systems(
+            world,
+            PhysicsSchedule,
+            MeasureSystems::configure(
+                super::diagnostics::measure_joints
+                    .run_if(any_with_component::<JointImpulse>)
+                    .run_if(energy_on),
+            ),
+        );
         crate::core::restore::init::<JointSettings>(world);
+        crate::core::restore::init::<super::JointDiagnostics>(world);
         // The whole-step path knows no joints: worlds with one take the schedule.
         crate::core::whole_step::block_on::<SphericalJoint>(world);
         crate::core::whole_step::block_on::<RevoluteJoint>(world);
@@ -194,7 +206,7 @@ fn store(bodies: &mut Bodies, e: Option<Entity>, side: &Side) {
     }
     if let (Some(mut l), Some(i)) = (l, inertia) {
         let l = l.bypass_change_detection();
-        l.0 += side.dl;
+        l.0 += side.momentum.map_or(side.dl, |m| m * side.dl);
         if let Some(mut w) = w {
             w.bypass_change_detection().0 = i.angular_velocity(q.0, l.0);
         }
@@ -206,6 +218,8 @@ fn store(bodies: &mut Bodies, e: Option<Entity>, side: &Side) {
 struct Scratch {
     /// Every side the pass reads: each moving body once, then immovable sides per joint.
     sides: Vec<Side>,
+    /// Per side: its centre of mass in its shape frame (m).
+    coms: Vec<Vec3>,
     entities: Vec<Option<Entity>>,
     index: HashMap<Entity, usize>,
     /// Per joint: its geometry and its sides' places in `sides`.
@@ -219,6 +233,12 @@ struct Scratch {
     matrix: Vec<f64>,
     /// Per group root, its first joint (groups are solved in that order).
     first: HashMap<usize, usize>,
+    /// Per side: counted in [`mostly_tree`].
+    seen: Vec<bool>,
+    /// The tree solve's memory, for groups too large for one dense block.
+    tree: TreeScratch,
+    /// Per side, the geometric stiffness of its joints' pull (N·m per rad).
+    stiffness: Vec<Mat3A>,
 }
 
 fn root(parent: &mut [usize], mut i: usize) -> usize {
@@ -233,14 +253,11 @@ fn root(parent: &mut [usize], mut i: usize) -> usize {
 /// place of their own each time.
 fn place(s: &mut Scratch, bodies: &Bodies, e: Option<Entity>, anchor: Vec3) -> (usize, Vec3A) {
     if let Some(&i) = e.and_then(|e| s.index.get(&e)) {
-        let com = e
-            .and_then(|e| bodies.get(e).ok())
-            .and_then(|b| b.2)
-            .map_or(Vec3::ZERO, |c| c.0);
-        return (i, Vec3A::from(anchor - com));
+        return (i, Vec3A::from(anchor - s.coms[i]));
     }
     let (side, local) = load(bodies, e, anchor);
     let i = s.sides.len();
+    s.coms.push(anchor - Vec3::from(local));
     if side.moves
         && let Some(e) = e
     {
@@ -256,6 +273,7 @@ fn place(s: &mut Scratch, bodies: &Bodies, e: Option<Entity>, anchor: Vec3) -> (
 /// [`block::MAX_GROUP_ROWS`] rows), or joint after joint when larger.
 fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32, s: &mut Scratch) {
     s.sides.clear();
+    s.coms.clear();
     s.entities.clear();
     s.index.clear();
     s.joints.clear();
@@ -263,12 +281,13 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     for (joint, impulse) in joints.iter() {
         // A body that is gone or quarantined leaves the joint inert: its partner runs free
         // (and the joint exerts nothing) until it is back.
-        let gone = |e: Entity| bodies.get(e).is_err();
+        let gone = |e: Entity| !s.index.contains_key(&e) && bodies.get(e).is_err();
         let described =
             describe(joint).filter(|(ends, _)| !(ends.a.is_some_and(gone) || gone(ends.b)));
         let Some((ends, angular)) = described else {
             let inert = s.sides.len();
             s.sides.push(Side::WORLD);
+            s.coms.push(Vec3::ZERO);
             s.entities.push(None);
             let rows = Rows {
                 local_a: Vec3A::ZERO,
@@ -292,6 +311,7 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
             angular: impulse.angular.into(),
         });
     }
+    stiffen_sides(s, joints, h);
     if warm {
         for (j, &(rows, ia, ib)) in s.joints.iter().enumerate() {
             if let Ok([a, b]) = s.sides.get_disjoint_mut([ia, ib]) {
@@ -320,22 +340,42 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     for &(g, j) in &s.order {
         s.first.entry(g).or_insert(j);
     }
-    let first = &s.first;
-    s.order.sort_by_key(|&(g, j)| (first[&g], j));
+    for o in &mut s.order {
+        o.0 = s.first[&o.0];
+    }
+    // Keys are unique (a joint is in one group), so an unstable sort orders them fully.
+    s.order.sort_unstable();
     let mut k = 0;
     while k < s.order.len() {
         let group = s.order[k].0;
         let end = k + s.order[k..].iter().take_while(|o| o.0 == group).count();
-        s.rows.clear();
-        for i in k..end {
-            let j = s.order[i].1;
-            push_rows(s, j);
-        }
-        if s.rows.len() <= block::MAX_GROUP_ROWS {
-            block::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.matrix);
-        } else {
+        let count: usize = s.order[k..end]
+            .iter()
+            .map(|&(_, j)| s.joints[j].0.angular.rows() + 3)
+            .sum();
+        if count <= block::MAX_GROUP_ROWS || mostly_tree(s, k, end) {
+            s.rows.clear();
             for i in k..end {
                 let j = s.order[i].1;
+                push_rows(s, j);
+            }
+            if count <= block::MAX_GROUP_ROWS {
+                block::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.matrix);
+            } else {
+                tree::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.tree);
+            }
+        } else {
+            // A mesh of loops (a net, a grid): the tree would leave most joints to be solved
+            // after it anyway, so each joint is solved on its own, as Box2D solves them.
+            for i in k..end {
+                let (rows, ia, ib) = s.joints[s.order[i].1];
+                let j = s.order[i].1;
+                if let (Angular::Free, Ok([a, b])) =
+                    (rows.angular, s.sides.get_disjoint_mut([ia, ib]))
+                {
+                    solve::solve_ball(&rows, a, b, &mut s.acc[j], mode);
+                    continue;
+                }
                 s.rows.clear();
                 push_rows(s, j);
                 block::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.matrix);
@@ -353,6 +393,57 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
         impulse.angular = acc.angular.into();
         impulse.h = h;
     }
+}
+
+/// Stiffens the inertia of every moving side by the geometric stiffness of the forces its
+/// joints exerted in the last substep ([`solve::stiffen`]).
+fn stiffen_sides(s: &mut Scratch, joints: &Joints, h: f32) {
+    s.stiffness.clear();
+    s.stiffness.resize(s.sides.len(), Mat3A::ZERO);
+    let mut any = false;
+    for ((&(rows, ia, ib), acc), (_, impulse)) in s.joints.iter().zip(&s.acc).zip(joints.iter()) {
+        if impulse.h.is_nan() || impulse.h <= 0.0 {
+            continue;
+        }
+        let f = acc.linear / impulse.h;
+        for (i, local) in [(ia, rows.local_a), (ib, rows.local_b)] {
+            let side = &s.sides[i];
+            if side.moves {
+                s.stiffness[i] += solve::geometric_stiffness(f, side.q * local);
+                any = true;
+            }
+        }
+    }
+    if !any {
+        return;
+    }
+    for (side, &k) in s.sides.iter_mut().zip(&s.stiffness) {
+        if side.moves && k != Mat3A::ZERO {
+            solve::stiffen(side, k, h);
+        }
+    }
+}
+
+/// Whether the group of joints `s.order[k..end]` is a tree but for a few loops: fewer than
+/// one joint in ten closes one (a chain, a ragdoll, a bridge; not a net). A connected group
+/// of B bodies and L joints between two of them has L − B + 1 loops.
+fn mostly_tree(s: &mut Scratch, k: usize, end: usize) -> bool {
+    s.seen.clear();
+    s.seen.resize(s.sides.len(), false);
+    let (mut bodies, mut links) = (0_usize, 0_usize);
+    for &(_, j) in &s.order[k..end] {
+        let (_, ia, ib) = s.joints[j];
+        let (ma, mb) = (s.sides[ia].moves, s.sides[ib].moves);
+        links += usize::from(ma && mb);
+        for (i, moves) in [(ia, ma), (ib, mb)] {
+            if moves && !s.seen[i] {
+                s.seen[i] = true;
+                bodies += 1;
+            }
+        }
+    }
+    let loops = (links + 1).saturating_sub(bodies);
+    loops * 10 < end - k
 }
 
 /// Appends joint `j`'s rows to `s.rows`, each side named only if it moves.

@@ -12,9 +12,10 @@
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 
-use crate::collision::{Collider, ColliderDensity, Friction};
+use crate::collision::{Collider, ColliderDensity, CollisionLayers, Friction};
 use crate::core::error::Result;
 use crate::core::time::PhysicsTime;
+use crate::joints::SphericalJoint;
 use crate::particles::Gravity;
 use crate::particles::{LinearVelocity, Position};
 use crate::plugins::{PhysicsPlugins, PhysicsWorldExt};
@@ -38,6 +39,10 @@ pub enum Scene {
     /// sphere of radius 2 m (density 1000 kg/m³), dropped in a grid that collapses into a
     /// pile; 500 steps.
     ConvexPile,
+    /// `joint_grid`: 100 × 100 spheres of radius 0.4 m (density 1 kg/m³) 1 m apart in a
+    /// vertical plane, each joined by ball joints to the one above and the one beside it
+    /// (19,800 joints), the top row static; the spheres do not collide. 100 steps.
+    JointGrid,
     /// `washer`: 20 × 20 × 20 = 8,000 cubes of 0.4 m (density 1000 kg/m³) tumbling in a
     /// kinematic drum of 40 hulls turning at 25°/s about z; 1,000 steps.
     Washer,
@@ -45,7 +50,8 @@ pub enum Scene {
 
 impl Scene {
     /// The suite, in Box3D's order.
-    pub const ALL: [Scene; 4] = [
+    pub const ALL: [Scene; 5] = [
+        Scene::JointGrid,
         Scene::ConvexPile,
         Scene::LargePyramid,
         Scene::ManyPyramids,
@@ -59,6 +65,7 @@ impl Scene {
             Scene::LargePyramid => "large_pyramid",
             Scene::ManyPyramids => "many_pyramids",
             Scene::ConvexPile => "convex_pile",
+            Scene::JointGrid => "joint_grid",
             Scene::Washer => "washer",
         }
     }
@@ -68,7 +75,7 @@ impl Scene {
     pub fn steps(self) -> usize {
         match self {
             Scene::LargePyramid => 200,
-            Scene::ManyPyramids => 100,
+            Scene::ManyPyramids | Scene::JointGrid => 100,
             Scene::ConvexPile => 500,
             Scene::Washer => 1000,
         }
@@ -81,7 +88,8 @@ impl Scene {
     }
 
     /// The scene's size: Box3D's full size, or its `BENCHMARK_DEBUG` size (a pyramid of base
-    /// 20, 3 × 3 pyramids, 10 layers of hulls, 8 × 8 × 8 cubes in the drum) when `small`.
+    /// 20, 3 × 3 pyramids, 10 layers of hulls, 10 × 10 spheres, 8 × 8 × 8 cubes in the drum)
+    /// when `small`.
     #[must_use]
     pub fn bodies(self, small: bool) -> SceneBodies {
         match (self, small) {
@@ -91,6 +99,8 @@ impl Scene {
             (Scene::ManyPyramids, true) => SceneBodies::Boxes(many_pyramids(3, 3, 10)),
             (Scene::ConvexPile, false) => SceneBodies::Hulls(convex_pile(80)),
             (Scene::ConvexPile, true) => SceneBodies::Hulls(convex_pile(10)),
+            (Scene::JointGrid, false) => SceneBodies::JointGrid(JointGridSpec { side: 100 }),
+            (Scene::JointGrid, true) => SceneBodies::JointGrid(JointGridSpec { side: 10 }),
             (Scene::Washer, false) => SceneBodies::Washer(washer(20)),
             (Scene::Washer, true) => SceneBodies::Washer(washer(8)),
         }
@@ -101,6 +111,7 @@ impl Scene {
     pub fn density(self) -> f32 {
         match self {
             Scene::LargePyramid | Scene::ManyPyramids => 100.0,
+            Scene::JointGrid => 1.0,
             Scene::ConvexPile | Scene::Washer => 1000.0,
         }
     }
@@ -115,6 +126,59 @@ pub enum SceneBodies {
     Hulls(HullPile),
     /// A static ground, a turning kinematic drum and cubes inside it.
     Washer(WasherSpec),
+    /// Spheres on ball joints in a square grid.
+    JointGrid(JointGridSpec),
+}
+
+/// Box3D's joint grid: `side` × `side` spheres, column k at x = k m, row i at y = −i m.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct JointGridSpec {
+    /// Spheres along each side.
+    pub side: usize,
+}
+
+impl JointGridSpec {
+    /// The spheres' radius (m).
+    pub const RADIUS: f32 = 0.4;
+
+    /// The joints, as (body a, body b, anchor on a, anchor on b) over the spheres indexed
+    /// column after column (`k * side + i`), in Box3D's order: to the sphere above, then to
+    /// the one in the column before. The top row's joints to each other join two static
+    /// bodies; they are kept, as Box3D keeps them.
+    #[must_use]
+    pub fn joints(&self) -> Vec<(usize, usize, Vec3, Vec3)> {
+        let n = self.side;
+        let mut out = Vec::with_capacity(2 * n * n);
+        for k in 0..n {
+            for i in 0..n {
+                let index = k * n + i;
+                if i > 0 {
+                    out.push((
+                        index - 1,
+                        index,
+                        Vec3::new(0.0, -0.5, 0.0),
+                        Vec3::new(0.0, 0.5, 0.0),
+                    ));
+                }
+                if k > 0 {
+                    out.push((
+                        index - n,
+                        index,
+                        Vec3::new(0.5, 0.0, 0.0),
+                        Vec3::new(-0.5, 0.0, 0.0),
+                    ));
+                }
+            }
+        }
+        out
+    }
+
+    /// Sphere `index`'s place (m) and whether it is static (the top row).
+    #[must_use]
+    pub fn sphere(&self, index: usize) -> (Vec3, bool) {
+        let (k, i) = (index / self.side, index % self.side);
+        (Vec3::new(k as f32, -(i as f32), 0.0), i == 0)
+    }
 }
 
 /// The washer: a ground, a drum of hulls and the cubes tumbling in it.
@@ -354,6 +418,7 @@ pub fn spawn(world: &mut World, bodies: &SceneBodies, density: f32) -> Result<Ve
         if !fixed {
             out.push(e);
         }
+        e
     };
     match bodies {
         SceneBodies::Boxes(specs) => {
@@ -368,6 +433,27 @@ pub fn spawn(world: &mut World, bodies: &SceneBodies, density: f32) -> Result<Ve
             let hull = Collider::convex_hull(&pile.points)?;
             for &at in &pile.positions {
                 put(world, hull.clone(), at, false);
+            }
+        }
+        SceneBodies::JointGrid(grid) => {
+            crate::tools::scenes::check_boxes(Some(grid.side * grid.side))?;
+            let ball = Collider::ball(JointGridSpec::RADIUS)?;
+            let spheres: Vec<Entity> = (0..grid.side * grid.side)
+                .map(|index| {
+                    let (at, fixed) = grid.sphere(index);
+                    let e = put(world, ball.clone(), at, fixed);
+                    // Box3D's filter: category 2, colliding with everything but category 2.
+                    world.entity_mut(e).insert(CollisionLayers {
+                        memberships: 2,
+                        filters: !2,
+                    });
+                    e
+                })
+                .collect();
+            for (a, b, anchor_a, anchor_b) in grid.joints() {
+                world.spawn(
+                    SphericalJoint::new(spheres[a], spheres[b]).with_anchors(anchor_a, anchor_b),
+                );
             }
         }
         SceneBodies::Washer(washer) => {
@@ -422,11 +508,14 @@ mod tests {
             SceneBodies::Boxes(b) => b.len() - 1,
             SceneBodies::Hulls(h) => h.positions.len(),
             SceneBodies::Washer(w) => w.cubes.len(),
+            SceneBodies::JointGrid(g) => g.side * g.side,
         };
         assert_eq!(count(Scene::LargePyramid), 5050);
         assert_eq!(count(Scene::ManyPyramids), 10_780);
         assert_eq!(count(Scene::ConvexPile), 5120);
         assert_eq!(count(Scene::Washer), 8000);
+        assert_eq!(count(Scene::JointGrid), 10_000);
+        assert_eq!(JointGridSpec { side: 100 }.joints().len(), 19_800);
     }
 
     #[test]
