@@ -118,14 +118,23 @@ struct ChainRun {
 /// from the vertical, each rod below the first spinning at 0.4 k rad/s about the vertical
 /// (so the motion is three-dimensional); no damping anywhere.
 fn hooke_chain(links: usize) -> ChainRun {
-    let mut world = default_world();
+    hooke_chain_in(default_world(), links, 60.0, false)
+}
+
+/// [`hooke_chain`] in `world` for `seconds`, the rods and joints spawned from the bottom up
+/// when `reversed`.
+fn hooke_chain_in(mut world: World, links: usize, seconds: f32, reversed: bool) -> ChainRun {
     let pivot = Vec3::new(0.0, 3.0, 0.0);
     let turn = Quat::from_rotation_z(1.2);
-    let mut above = None;
-    let mut rods = Vec::new();
-    for k in 0..links {
+    let order: Vec<usize> = if reversed {
+        (0..links).rev().collect()
+    } else {
+        (0..links).collect()
+    };
+    let mut rods = vec![Entity::PLACEHOLDER; links];
+    for &k in &order {
         let top = pivot + turn * Vec3::new(0.0, -2.0 * HALF.y * k as f32, 0.0);
-        let rod = world
+        rods[k] = world
             .spawn((
                 RigidBody::Dynamic,
                 Collider::cuboid(HALF.x, HALF.y, HALF.z).unwrap(),
@@ -134,15 +143,15 @@ fn hooke_chain(links: usize) -> ChainRun {
                 AngularVelocity(Vec3A::new(0.0, 0.4 * k as f32, 0.0)),
             ))
             .id();
-        let joint = match above {
-            None => SphericalJoint::to_world(rod).with_anchors(pivot, Vec3::Y * HALF.y),
-            Some(up) => {
-                SphericalJoint::new(up, rod).with_anchors(-Vec3::Y * HALF.y, Vec3::Y * HALF.y)
-            }
+    }
+    for &k in &order {
+        let rod = rods[k];
+        let joint = if k == 0 {
+            SphericalJoint::to_world(rod).with_anchors(pivot, Vec3::Y * HALF.y)
+        } else {
+            SphericalJoint::new(rods[k - 1], rod).with_anchors(-Vec3::Y * HALF.y, Vec3::Y * HALF.y)
         };
         world.spawn(joint);
-        above = Some(rod);
-        rods.push(rod);
     }
     let energy = |world: &World| -> f64 {
         rods.iter()
@@ -177,7 +186,8 @@ fn hooke_chain(links: usize) -> ChainRun {
         end: start,
         drift: 0.0,
     };
-    for _ in 0..3600 {
+    let dt = world.resource::<PhysicsTime>().dt();
+    for _ in 0..(seconds / dt).round() as usize {
         world.step_physics();
         run.highest = run.highest.max(energy(&world));
         run.drift = run.drift.max(drift(&world));
@@ -259,6 +269,38 @@ fn a_pendulum_chain_on_ball_joints_never_gains_energy() {
             "{links} links: anchors parted {} m",
             run.drift
         );
+    }
+}
+
+#[test]
+fn a_pendulum_chain_never_gains_energy_at_any_frame_rate_substeps_or_spawn_order() {
+    // Two and five rods for 20 s, spawned top down and bottom up (the same to 0.1 %).
+    // Measured highest rise, in the order of the settings: two rods 0.22, 0.19, 0.06 and
+    // 0.05 % of the start, five 0.33, 0.11, 0.11 and 0.08 %; widest parting 3.3 cm (five
+    // rods at one substep), 1.1 cm at 30 Hz, under 3 mm from 8 substeps or 144 Hz.
+    let settings = [
+        (1.0 / 30.0, 4),
+        (1.0 / 60.0, 1),
+        (1.0 / 60.0, 8),
+        (1.0 / 144.0, 4),
+    ];
+    for links in [2, 5] {
+        for (dt, substeps) in settings {
+            for reversed in [false, true] {
+                let mut world = default_world();
+                world.insert_resource(PhysicsTime::new(dt, substeps).unwrap());
+                let run = hooke_chain_in(world, links, 20.0, reversed);
+                let rise = (run.highest - run.start) / run.start;
+                assert!(
+                    rise < 5e-3 && run.drift < 0.05,
+                    "{links} rods at 1/{} s × {substeps}, reversed {reversed}: energy rose \
+                     {:.3} %, anchors parted {} m",
+                    (1.0 / dt).round(),
+                    100.0 * rise,
+                    run.drift
+                );
+            }
+        }
     }
 }
 
