@@ -204,6 +204,7 @@ pub mod prelude {
     pub use crate::core::time::PhysicsTime;
     pub use crate::integrator::Integrator;
     pub use crate::integrator::IntegratorOverride;
+    pub use crate::joints::AngularMotor;
     pub use crate::joints::FixedJoint;
     pub use crate::joints::JointDiagnostics;
     pub use crate::joints::JointImpulse;

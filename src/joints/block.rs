@@ -67,7 +67,7 @@ pub(super) fn joint_rows(
     };
     match rows.angular {
         Angular::Free => {}
-        Angular::Hinge { axis_a, axis_b } => {
+        Angular::Hinge { axis_a, axis_b, .. } => {
             let axis_a = a.q * Vec3A::from(axis_a);
             let axis_b = b.q * Vec3A::from(axis_b);
             let (u, v) = glam::Vec3::from(axis_a).any_orthonormal_pair();
@@ -327,7 +327,7 @@ mod tests {
         };
         let start = Accumulated {
             linear: Vec3A::new(0.2, -0.1, 0.3),
-            angular: Vec3A::ZERO,
+            ..Default::default()
         };
         let mut rows = Vec::new();
         joint_rows(
@@ -356,6 +356,7 @@ mod tests {
             angular: Angular::Hinge {
                 axis_a: Vec3::Z,
                 axis_b: Vec3::Z,
+                motor: None,
             },
         };
         let mut sides = vec![Side::WORLD, body(Vec3A::ZERO)];

@@ -221,6 +221,20 @@ pub struct RevoluteJoint {
     pub axis_a: Vec3,
     /// The hinge axis in `b`'s shape frame; unit length.
     pub axis_b: Vec3,
+    /// A motor driving `b`'s turn relative to `a` about the axis, if any.
+    #[serde(default)]
+    pub motor: Option<AngularMotor>,
+}
+
+/// A motor on a hinge: it drives the turn of `b` relative to `a` about the hinge axis (axis
+/// direction, right-handed) towards `target_velocity`, with at most `max_torque`. Solved in
+/// every pass before the joint's other rows, as Box2D solves its motors.
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
+pub struct AngularMotor {
+    /// The relative angular velocity it drives towards (rad/s).
+    pub target_velocity: f32,
+    /// The largest torque it exerts (N·m, ≥ 0).
+    pub max_torque: f32,
 }
 
 impl RevoluteJoint {
@@ -232,6 +246,7 @@ impl RevoluteJoint {
             bodies: SphericalJoint::new(a, b).bodies,
             axis_a: axis.normalize_or_zero(),
             axis_b: axis.normalize_or_zero(),
+            motor: None,
         }
     }
 
@@ -243,7 +258,19 @@ impl RevoluteJoint {
             bodies: SphericalJoint::to_world(b).bodies,
             axis_a: axis.normalize_or_zero(),
             axis_b: axis.normalize_or_zero(),
+            motor: None,
         }
+    }
+
+    /// Drives the hinge towards `target_velocity` (rad/s, `b` relative to `a`, right-handed
+    /// about the axis) with at most `max_torque` (N·m).
+    #[must_use]
+    pub fn with_motor(mut self, target_velocity: f32, max_torque: f32) -> Self {
+        self.motor = Some(AngularMotor {
+            target_velocity,
+            max_torque,
+        });
+        self
     }
 }
 joint_builders!(RevoluteJoint);
@@ -260,6 +287,11 @@ impl Validate for RevoluteJoint {
                     range: "length 1 (a unit vector)",
                 });
             }
+        }
+        if let Some(m) = self.motor {
+            crate::core::error::finite("motor target velocity", m.target_velocity)?;
+            crate::core::error::finite("motor max torque", m.max_torque)?;
+            crate::core::error::non_negative("motor max torque", m.max_torque)?;
         }
         Ok(())
     }
@@ -316,6 +348,9 @@ pub struct JointImpulse {
     pub angular: Vec3,
     /// The substep length it was applied over (s).
     pub h: f32,
+    /// A hinge motor's angular impulse about the hinge axis (N·m·s).
+    #[serde(default)]
+    pub motor: f32,
 }
 
 impl JointImpulse {
@@ -329,7 +364,18 @@ impl JointImpulse {
         }
     }
 
-    /// The torque the joint exerts on `b` about its anchor (N·m, world frame).
+    /// The torque a hinge's motor exerts on `b` about the hinge axis (N·m).
+    #[must_use]
+    pub fn motor_torque(&self) -> f32 {
+        if self.h > 0.0 {
+            self.motor / self.h
+        } else {
+            0.0
+        }
+    }
+
+    /// The torque the joint's rows (not its motor) exert on `b` about its anchor (N·m,
+    /// world frame).
     #[must_use]
     pub fn torque(&self) -> Vec3 {
         if self.h > 0.0 {

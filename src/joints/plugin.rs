@@ -150,6 +150,7 @@ fn describe(
             Angular::Hinge {
                 axis_a: j.axis_a,
                 axis_b: j.axis_b,
+                motor: j.motor,
             },
         )),
         (_, _, Some(j)) => Some((
@@ -309,6 +310,7 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
         s.acc.push(Accumulated {
             linear: impulse.linear.into(),
             angular: impulse.angular.into(),
+            motor: impulse.motor,
         });
     }
     stiffen_sides(s, joints, h);
@@ -319,6 +321,9 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
             }
         }
     }
+    // Motors first, each on its own (Box2D's order): the rows after them keep what they
+    // leave free, the turn about the hinge.
+    motors(s, h);
     // Groups: bodies joined through moving bodies (an immovable side joins nothing).
     s.parent.clear();
     s.parent.extend(0..s.sides.len());
@@ -391,6 +396,7 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
         let impulse = impulse.bypass_change_detection();
         impulse.linear = acc.linear.into();
         impulse.angular = acc.angular.into();
+        impulse.motor = acc.motor;
         impulse.h = h;
     }
 }
@@ -420,6 +426,17 @@ fn stiffen_sides(s: &mut Scratch, joints: &Joints, h: f32) {
     for (side, &k) in s.sides.iter_mut().zip(&s.stiffness) {
         if side.moves && k != Mat3A::ZERO {
             solve::stiffen(side, k, h);
+        }
+    }
+}
+
+/// Drives every hinge motor, each on its own.
+fn motors(s: &mut Scratch, h: f32) {
+    for (j, &(rows, ia, ib)) in s.joints.iter().enumerate() {
+        if let Angular::Hinge { motor: Some(_), .. } = rows.angular
+            && let Ok([a, b]) = s.sides.get_disjoint_mut([ia, ib])
+        {
+            solve::solve_motor(&rows, a, b, &mut s.acc[j], h);
         }
     }
 }

@@ -10,6 +10,7 @@
 
 use glam::{Mat3A, Quat, Vec3, Vec3A};
 
+use super::AngularMotor;
 use crate::collision::solver::Softness;
 
 /// One side of a joint during a pass.
@@ -62,8 +63,12 @@ impl Side {
 pub(super) enum Angular {
     /// Nothing: a ball joint.
     Free,
-    /// The hinge axes (each side's shape frame) aligned.
-    Hinge { axis_a: Vec3, axis_b: Vec3 },
+    /// The hinge axes (each side's shape frame) aligned, and the hinge's motor.
+    Hinge {
+        axis_a: Vec3,
+        axis_b: Vec3,
+        motor: Option<AngularMotor>,
+    },
     /// q_b = q_a · relative.
     Weld { relative: Quat },
 }
@@ -93,6 +98,8 @@ pub(super) struct Rows {
 pub(super) struct Accumulated {
     pub linear: Vec3A,
     pub angular: Vec3A,
+    /// A hinge motor's impulse about the hinge axis (N·m·s).
+    pub motor: f32,
 }
 
 /// [`Softness`] for a biased pass, or the rigid solve of a relax pass.
@@ -130,8 +137,43 @@ fn arms(rows: &Rows, a: &Side, b: &Side) -> (Vec3A, Vec3A, Vec3A) {
 /// Applies the accumulated impulses again (the warm start of a substep).
 pub(super) fn warm_start(rows: &Rows, acc: &Accumulated, a: &mut Side, b: &mut Side) {
     let (r_a, r_b, _) = arms(rows, a, b);
-    a.push(-acc.linear, r_a, -acc.angular);
-    b.push(acc.linear, r_b, acc.angular);
+    let motor = match rows.angular {
+        Angular::Hinge { axis_a, .. } => acc.motor * (a.q * Vec3A::from(axis_a)),
+        _ => Vec3A::ZERO,
+    };
+    a.push(-acc.linear, r_a, -acc.angular - motor);
+    b.push(acc.linear, r_b, acc.angular + motor);
+}
+
+/// Drives a hinge's motor one step: the relative turn rate about the axis (a's axis in the
+/// world) towards the target, the accumulated impulse kept within ±max_torque · h. Rigid in
+/// every pass: a motor is a velocity target, with nothing to correct at the position level.
+pub(super) fn solve_motor(rows: &Rows, a: &mut Side, b: &mut Side, acc: &mut Accumulated, h: f32) {
+    let Angular::Hinge {
+        axis_a,
+        motor: Some(motor),
+        ..
+    } = rows.angular
+    else {
+        return;
+    };
+    let axis = a.q * Vec3A::from(axis_a);
+    let mut k = 0.0;
+    for side in [&*a, &*b] {
+        if side.moves {
+            k += axis.dot(side.inv_i * axis);
+        }
+    }
+    if !(k > 0.0 && k.is_finite()) {
+        return;
+    }
+    let rate = (b.w - a.w).dot(axis);
+    let limit = motor.max_torque * h;
+    let held = acc.motor;
+    acc.motor = (held - (rate - motor.target_velocity) / k).clamp(-limit, limit);
+    let lambda = acc.motor - held;
+    a.push(Vec3A::ZERO, Vec3A::ZERO, -lambda * axis);
+    b.push(Vec3A::ZERO, Vec3A::ZERO, lambda * axis);
 }
 
 /// Solves a ball joint's three rows on their own: K λ = −S_m (Ċ + β C) − S_i λ_acc with

@@ -512,6 +512,7 @@ mod tests {
                     angular: Angular::Hinge {
                         axis_a: Vec3::Z,
                         axis_b: Vec3::Z,
+                        motor: None,
                     },
                     ..ball(Vec3A::new(0.2, 0.0, 0.0), Vec3A::new(-0.2, 0.0, 0.0))
                 },
@@ -551,7 +552,7 @@ mod tests {
             let mut acc = vec![
                 Accumulated {
                     linear: Vec3A::X,
-                    angular: Vec3A::ZERO
+                    ..Default::default()
                 };
                 5
             ];

@@ -1,4 +1,5 @@
 //! Joints against closed forms, at the defaults.
 
 mod hard_cases;
+mod motors;
 mod pendulums;

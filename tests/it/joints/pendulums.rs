@@ -424,6 +424,9 @@ fn a_joint_with_a_bad_input_is_quarantined_with_its_reason() {
         world
             .spawn(FixedJoint::to_world(body, Quat::IDENTITY).with_anchors(Vec3::NAN, Vec3::ZERO))
             .id(),
+        world
+            .spawn(RevoluteJoint::to_world(body, Vec3::Z).with_motor(1.0, -5.0))
+            .id(),
     ];
     world.step_physics();
     let reasons: Vec<String> = cases
@@ -436,6 +439,7 @@ fn a_joint_with_a_bad_input_is_quarantined_with_its_reason() {
     assert!(reasons[0].contains("itself"), "{}", reasons[0]);
     assert!(reasons[1].contains("hinge axis b"), "{}", reasons[1]);
     assert!(reasons[2].contains("joint anchor a"), "{}", reasons[2]);
+    assert!(reasons[3].contains("motor max torque"), "{}", reasons[3]);
     // The body itself runs on.
     assert!(world.get::<Quarantined>(body).is_none());
 }

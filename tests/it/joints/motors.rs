@@ -1,0 +1,114 @@
+//! A hinge's motor against the closed forms of a driven flywheel, at the defaults.
+
+use bevy_ecs::prelude::*;
+use hooke::prelude::*;
+use hooke::rigid::ExternalTorque;
+
+use crate::common::default_world;
+
+/// A ball of radius 0.5 m (1000 kg/m³: m = 523.6 kg, I = 2/5 m r² = 52.36 kg·m²) hinged at
+/// its centre to the world about z, its motor driving it to `target` rad/s with at most
+/// `max_torque` N·m against a load torque `load` N·m about z. Returns the world, the ball,
+/// the joint and the ball's moment of inertia about z.
+fn flywheel(target: f32, max_torque: f32, load: f32) -> (World, Entity, Entity, f32) {
+    let mut world = default_world();
+    let ball = world
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::ball(0.5).unwrap(),
+            Position(Vec3A::new(0.0, 2.0, 0.0)),
+            ExternalTorque(Vec3A::new(0.0, 0.0, -load)),
+        ))
+        .id();
+    let joint = world
+        .spawn(
+            RevoluteJoint::to_world(ball, Vec3::Z)
+                .with_anchors(Vec3::new(0.0, 2.0, 0.0), Vec3::ZERO)
+                .with_motor(target, max_torque),
+        )
+        .id();
+    world.step_physics();
+    let inertia = world
+        .get::<hooke::rigid::Inertia>(ball)
+        .unwrap()
+        .tensor()
+        .z_axis
+        .z;
+    (world, ball, joint, inertia)
+}
+
+fn spin(world: &World, ball: Entity) -> f32 {
+    world.get::<AngularVelocity>(ball).unwrap().0.z
+}
+
+#[test]
+fn a_hinge_motor_spins_up_at_its_torque_and_holds_its_target_speed() {
+    // Unloaded: ω = (τ_max / I) t until the target, then the target. 10 rad/s at 100 N·m on
+    // I = 52.36 kg·m²: 5.236 s.
+    let (target, max_torque) = (10.0_f32, 100.0_f32);
+    let (mut world, ball, joint, inertia) = flywheel(target, max_torque, 0.0);
+    let dt = 1.0 / 60.0;
+    let mut t = dt;
+    let reach = inertia * target / max_torque;
+    while t < reach - 0.1 {
+        world.step_physics();
+        t += dt;
+        let expected = max_torque / inertia * t;
+        assert!(
+            (spin(&world, ball) - expected).abs() < 1e-3 * target,
+            "at {t} s: {} rad/s, closed form {expected}",
+            spin(&world, ball)
+        );
+        let torque = world.get::<JointImpulse>(joint).unwrap().motor_torque();
+        assert!(
+            (torque - max_torque).abs() < 1e-3 * max_torque,
+            "{torque} N·m"
+        );
+    }
+    for _ in 0..60 {
+        world.step_physics();
+    }
+    assert!(
+        (spin(&world, ball) - target).abs() < 1e-4 * target,
+        "{}",
+        spin(&world, ball)
+    );
+    // At speed and unloaded, the motor has nothing left to push.
+    let torque = world.get::<JointImpulse>(joint).unwrap().motor_torque();
+    assert!(torque.abs() < 1e-2, "{torque} N·m");
+}
+
+#[test]
+fn a_hinge_motor_holds_against_a_load_below_its_torque_and_stalls_above() {
+    let (target, max_torque) = (10.0_f32, 100.0_f32);
+    // Below: at speed after spinning up at (τ_max − τ_load) / I, the motor gives τ_load.
+    let (mut world, ball, joint, _) = flywheel(target, max_torque, 60.0);
+    for _ in 0..20 * 60 {
+        world.step_physics();
+    }
+    assert!(
+        (spin(&world, ball) - target).abs() < 1e-4 * target,
+        "{}",
+        spin(&world, ball)
+    );
+    let torque = world.get::<JointImpulse>(joint).unwrap().motor_torque();
+    assert!((torque - 60.0).abs() < 0.1, "{torque} N·m");
+    // Above: the load wins; the wheel turns backwards at α = (τ_max − τ_load) / I.
+    let (mut world, ball, joint, inertia) = flywheel(target, max_torque, 150.0);
+    let steps = 120;
+    for _ in 0..steps {
+        world.step_physics();
+    }
+    let t = (steps + 1) as f32 / 60.0;
+    let expected = (max_torque - 150.0) / inertia * t;
+    assert!(
+        (spin(&world, ball) - expected).abs() < 1e-3 * expected.abs(),
+        "{} rad/s, closed form {expected}",
+        spin(&world, ball)
+    );
+    let torque = world.get::<JointImpulse>(joint).unwrap().motor_torque();
+    assert!(
+        (torque - max_torque).abs() < 1e-3 * max_torque,
+        "{torque} N·m"
+    );
+}
