@@ -317,7 +317,7 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     if warm {
         for (j, &(rows, ia, ib)) in s.joints.iter().enumerate() {
             if let Ok([a, b]) = s.sides.get_disjoint_mut([ia, ib]) {
-                solve::warm_start(&rows, &s.acc[j], a, b);
+                solve::warm_start(&rows, &mut s.acc[j], a, b);
             }
         }
     }

@@ -134,11 +134,19 @@ fn arms(rows: &Rows, a: &Side, b: &Side) -> (Vec3A, Vec3A, Vec3A) {
     (r_a, r_b, (b.x + r_b) - (a.x + r_a))
 }
 
-/// Applies the accumulated impulses again (the warm start of a substep).
-pub(super) fn warm_start(rows: &Rows, acc: &Accumulated, a: &mut Side, b: &mut Side) {
+/// Applies the accumulated impulses again (the warm start of a substep). A hinge's angular
+/// impulse is first projected off its axis as it now stands: it was found perpendicular to
+/// the axis of the last substep, and the part of it along the turned axis would spin the
+/// hinge, which its rows leave free (a spinning wheel on a swinging arm gained speed that
+/// way, past what its motor could hold).
+pub(super) fn warm_start(rows: &Rows, acc: &mut Accumulated, a: &mut Side, b: &mut Side) {
     let (r_a, r_b, _) = arms(rows, a, b);
     let motor = match rows.angular {
-        Angular::Hinge { axis_a, .. } => acc.motor * (a.q * Vec3A::from(axis_a)),
+        Angular::Hinge { axis_a, .. } => {
+            let axis = a.q * Vec3A::from(axis_a);
+            acc.angular -= axis * axis.dot(acc.angular);
+            acc.motor * axis
+        }
         _ => Vec3A::ZERO,
     };
     a.push(-acc.linear, r_a, -acc.angular - motor);
