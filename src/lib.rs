@@ -205,9 +205,13 @@ pub mod prelude {
     pub use crate::integrator::Integrator;
     pub use crate::integrator::IntegratorOverride;
     pub use crate::joints::AngularMotor;
+    pub use crate::joints::DistanceJoint;
     pub use crate::joints::FixedJoint;
     pub use crate::joints::JointDiagnostics;
     pub use crate::joints::JointImpulse;
+    pub use crate::joints::JointLimits;
+    pub use crate::joints::LinearMotor;
+    pub use crate::joints::PrismaticJoint;
     pub use crate::joints::RevoluteJoint;
     pub use crate::joints::SphericalJoint;
     pub use crate::particles::Advection;

@@ -13,7 +13,7 @@
 
 use glam::Vec3A;
 
-use super::solve::{Accumulated, Angular, Mode, Rows, Side};
+use super::solve::{Accumulated, Angular, Linear, Mode, Rows, Side};
 
 /// Rows above which a group falls back to one joint after another: the dense solve costs
 /// rows³/3 per pass (96 rows: 0.3 M operations).
@@ -90,10 +90,11 @@ pub(super) fn joint_rows(
     let r_a = a.q * rows.local_a;
     let r_b = b.q * rows.local_b;
     let gap = (b.x + r_b) - (a.x + r_a);
-    for e in [Vec3A::X, Vec3A::Y, Vec3A::Z] {
+    let arm_a = super::solve::lever_a(rows, r_a, gap);
+    let mut linear = |e: Vec3A| {
         out.push(Row {
             lin_a: -e,
-            ang_a: -r_a.cross(e),
+            ang_a: -arm_a.cross(e),
             lin_b: e,
             ang_b: r_b.cross(e),
             dir: e,
@@ -101,6 +102,15 @@ pub(super) fn joint_rows(
             c: e.dot(gap),
             ..base
         });
+    };
+    match rows.linear {
+        Linear::Point => [Vec3A::X, Vec3A::Y, Vec3A::Z].into_iter().for_each(linear),
+        Linear::Slide { axis_a } => {
+            let (u, v) = (a.q * axis_a).any_orthonormal_pair();
+            linear(u.into());
+            linear(v.into());
+        }
+        Linear::Free => {}
     }
 }
 
@@ -275,11 +285,7 @@ mod tests {
     #[test]
     fn a_rigid_pass_leaves_a_chain_without_relative_velocity_and_keeps_momentum() {
         // Three bodies in a row, two ball joints: solved as one system.
-        let geometry = Rows {
-            local_a: Vec3A::new(0.5, 0.0, 0.0),
-            local_b: Vec3A::new(-0.5, 0.0, 0.0),
-            angular: Angular::Free,
-        };
+        let geometry = Rows::ball(Vec3A::new(0.5, 0.0, 0.0), Vec3A::new(-0.5, 0.0, 0.0));
         let mut sides = vec![
             body(Vec3A::ZERO),
             body(Vec3A::new(1.0, 0.0, 0.0)),
@@ -311,11 +317,7 @@ mod tests {
 
     #[test]
     fn a_ball_joint_alone_is_solved_as_its_rows_are() {
-        let geometry = Rows {
-            local_a: Vec3A::new(0.5, 0.1, 0.0),
-            local_b: Vec3A::new(-0.4, 0.0, 0.2),
-            angular: Angular::Free,
-        };
+        let geometry = Rows::ball(Vec3A::new(0.5, 0.1, 0.0), Vec3A::new(-0.4, 0.0, 0.2));
         let mut sides = vec![body(Vec3A::ZERO), body(Vec3A::new(0.9, 0.2, -0.1))];
         sides[0].v = Vec3A::new(0.0, 1.0, 0.0);
         sides[1].w = Vec3A::new(0.3, -2.0, 0.7);
@@ -351,13 +353,11 @@ mod tests {
     #[test]
     fn a_rigid_hinge_pass_leaves_only_the_turn_about_its_axis() {
         let geometry = Rows {
-            local_a: Vec3A::ZERO,
-            local_b: Vec3A::ZERO,
             angular: Angular::Hinge {
                 axis_a: Vec3::Z,
                 axis_b: Vec3::Z,
-                motor: None,
             },
+            ..Rows::ball(Vec3A::ZERO, Vec3A::ZERO)
         };
         let mut sides = vec![Side::WORLD, body(Vec3A::ZERO)];
         sides[1].w = Vec3A::new(1.0, -2.0, 3.0);

@@ -4,7 +4,9 @@
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 
-use super::{FixedJoint, JointBodies, RevoluteJoint, SphericalJoint};
+use super::axial;
+use super::kinds::{Kinds, describe};
+use super::solve::{Angular, Axis, Linear, Rows, Side};
 use crate::core::quarantine::Quarantined;
 use crate::particles::Position;
 use crate::rigid::{CenterOfMass, Rotation};
@@ -15,34 +17,71 @@ use crate::rigid::{CenterOfMass, Rotation};
 pub struct JointDiagnostics {
     /// Joints measured (those not quarantined, with both bodies present).
     pub joints: usize,
-    /// The widest any joint's two anchors stand apart (m).
+    /// The widest any joint's two anchors stand apart across what it holds (m): the whole
+    /// separation of a ball, hinge or weld, a slider's off its rail, and how far a slider
+    /// or a distance joint stands past a limit.
     pub largest_gap: f32,
     /// The joint with that gap.
     pub widest: Option<Entity>,
-    /// The largest angular error (rad): a hinge's axes apart, a fixed joint's turn away
-    /// from its relative rotation.
+    /// The largest angular error (rad): a hinge's axes apart (and past its angle limits), a
+    /// fixed joint's or a slider's turn away from its relative rotation.
     pub largest_angle: f32,
 }
 
 type Pose<'a> = (&'a Position, &'a Rotation, Option<&'a CenterOfMass>);
 
-type Kinds<'a> = AnyOf<(&'a SphericalJoint, &'a RevoluteJoint, &'a FixedJoint)>;
-
-/// A body's shape-frame point `local` in the world; a world side's anchor as it is.
-fn world_point(bodies: &Query<Pose>, e: Option<Entity>, local: Vec3) -> Option<Vec3A> {
+/// A side's pose as the solver sees it, and its anchor from its centre of mass; a world
+/// side at the origin with its anchor as it is.
+fn pose(bodies: &Query<Pose>, e: Option<Entity>, anchor: Vec3) -> Option<(Side, Vec3A)> {
     let Some(e) = e else {
-        return Some(local.into());
+        return Some((Side::WORLD, anchor.into()));
     };
     let (x, q, com) = bodies.get(e).ok()?;
-    let from_centre = local - com.map_or(Vec3::ZERO, |c| c.0);
-    Some(x.0 + q.0 * Vec3A::from(from_centre))
+    let side = Side {
+        x: x.0,
+        q: q.0,
+        ..Side::WORLD
+    };
+    Some((side, Vec3A::from(anchor - com.map_or(Vec3::ZERO, |c| c.0))))
 }
 
-fn turn(bodies: &Query<Pose>, e: Option<Entity>) -> Option<glam::Quat> {
-    match e {
-        None => Some(glam::Quat::IDENTITY),
-        Some(e) => bodies.get(e).ok().map(|b| b.1.0),
+/// How far a joint stands from what it holds: (the anchors' separation across its locked
+/// rows and past its length or slide limits (m), the turn across its locked rows and past
+/// its angle limits (rad)).
+#[must_use]
+fn errors(rows: &Rows, a: &Side, b: &Side) -> (f32, f32) {
+    let r_a = a.q * rows.local_a;
+    let r_b = b.q * rows.local_b;
+    let d = (b.x + r_b) - (a.x + r_a);
+    let mut gap = match rows.linear {
+        Linear::Point => d.length(),
+        Linear::Slide { axis_a } => {
+            let n = a.q * Vec3A::from(axis_a);
+            (d - n * n.dot(d)).length()
+        }
+        Linear::Free => 0.0,
+    };
+    let apart = |u: Vec3A, v: Vec3A| u.cross(v).length().atan2(u.dot(v));
+    let mut angle = match rows.angular {
+        Angular::Free => 0.0,
+        Angular::Hinge { axis_a, axis_b } => {
+            apart(a.q * Vec3A::from(axis_a), b.q * Vec3A::from(axis_b))
+        }
+        Angular::Weld { relative } => {
+            let e = b.q * (a.q * relative).inverse();
+            2.0 * Vec3::new(e.x, e.y, e.z).length().atan2(e.w.abs())
+        }
+    };
+    if let (Some(axis), Some((min, max)), Some(value)) =
+        (rows.axial.axis, rows.axial.limits, axial::value(rows, a, b))
+    {
+        let past = (min - value).max(value - max).max(0.0);
+        match axis {
+            Axis::Turn { .. } => angle += past,
+            Axis::Slide { .. } | Axis::Length => gap += past,
+        }
     }
+    (gap, angle)
 }
 
 /// Measures every joint into [`JointDiagnostics`].
@@ -53,32 +92,30 @@ pub(super) fn measure_joints(
 ) {
     let mut d = JointDiagnostics::default();
     for (entity, kinds) in &joints {
-        let ends: &JointBodies = match kinds {
-            (Some(j), _, _) => &j.bodies,
-            (_, Some(j), _) => &j.bodies,
-            (_, _, Some(j)) => &j.bodies,
-            (None, None, None) => continue,
+        let Some(joint) = describe(kinds) else {
+            continue;
         };
-        let (Some(pa), Some(pb)) = (
-            world_point(&bodies, ends.a, ends.anchor_a),
-            world_point(&bodies, Some(ends.b), ends.anchor_b),
+        let ends = joint.bodies();
+        let (Some((a, local_a)), Some((b, local_b))) = (
+            pose(&bodies, ends.a, ends.anchor_a),
+            pose(&bodies, Some(ends.b), ends.anchor_b),
         ) else {
             continue;
         };
-        let (Some(qa), Some(qb)) = (turn(&bodies, ends.a), turn(&bodies, Some(ends.b))) else {
-            continue;
+        let (angular, linear, axial) = joint.rows();
+        let rows = Rows {
+            local_a,
+            local_b,
+            angular,
+            linear,
+            axial,
         };
+        let (gap, angle) = errors(&rows, &a, &b);
         d.joints += 1;
-        let gap = (pb - pa).length();
         if gap > d.largest_gap || d.widest.is_none() {
             d.largest_gap = gap;
             d.widest = Some(entity);
         }
-        let angle = match kinds {
-            (_, Some(h), _) => (qa * h.axis_a).angle_between(qb * h.axis_b),
-            (_, _, Some(f)) => (qa * f.relative).angle_between(qb),
-            _ => 0.0,
-        };
         if angle.is_finite() {
             d.largest_angle = d.largest_angle.max(angle);
         }

@@ -5,7 +5,13 @@
 //! |---|---|---|
 //! | [`SphericalJoint`] (ball) | the anchors together | every turn |
 //! | [`RevoluteJoint`] (hinge) | the anchors together, the hinge axes aligned | the turn about the axis |
+//! | [`PrismaticJoint`] (slider) | the relative rotation, `b`'s anchor on `a`'s axis | the slide along the axis |
+//! | [`DistanceJoint`] (rod, rope) | the anchors' distance within its limits | every turn |
 //! | [`FixedJoint`] | the anchors together, the relative rotation | nothing |
+//!
+//! A hinge's angle, a slider's offset and a distance joint's length are a joint's free axis:
+//! it takes [`JointLimits`] (`with_limits`) and, on hinges and sliders, a motor
+//! (`with_motor`: [`AngularMotor`], [`LinearMotor`]), solved before the locked rows.
 //!
 //! A joint is an entity of its own: spawn `RevoluteJoint::new(door, frame).with_anchors(..)`
 //! (or `::to_world(body)` for a body hinged to the world). Anchors are in each body's shape
@@ -13,7 +19,8 @@
 //! side's anchor is a world point. A static, kinematic or sleeping side is held where it is
 //! and takes no impulse. A joint naming a body that is gone or quarantined is inert (its
 //! partner runs free, its [`JointImpulse`] reads zero) until the body is back; a joint with a
-//! bad input (a non-finite anchor, a hinge axis not of unit length, a body joined to itself)
+//! bad input (a non-finite anchor, an axis not of unit length, limits with min > max, a body
+//! joined to itself)
 //! is quarantined on insert with an [`crate::Error`] saying which.
 //!
 //! **Solver.** Each substep, after the contacts' passes (see [`JointPlugin`]): the
@@ -56,17 +63,23 @@
 //! assert!((force.y - 98.1).abs() < 0.5, "{force}");
 //! ```
 
+mod axial;
 mod block;
 mod diagnostics;
+mod kinds;
 mod plugin;
 mod solve;
 mod tree;
 
 pub use diagnostics::JointDiagnostics;
+pub use kinds::{
+    AngularMotor, DistanceJoint, FixedJoint, JointLimits, LinearMotor, PrismaticJoint,
+    RevoluteJoint, SphericalJoint,
+};
 pub use plugin::JointPlugin;
 
 use bevy_ecs::prelude::*;
-use glam::{Quat, Vec3};
+use glam::Vec3;
 
 use crate::core::error::{Error, Result, finite_vec};
 use bevy_ecs::lifecycle::HookContext;
@@ -100,10 +113,8 @@ impl JointBodies {
     }
 }
 
-/// What every joint kind holds.
-trait Joint: Component + Validate {
-    fn bodies(&self) -> &JointBodies;
-}
+/// What every joint kind is.
+trait Joint: Component + Validate + kinds::Describe {}
 
 /// The two bodies of the joint on `entity`, when it keeps them from colliding.
 fn excluded_pair<T: Joint>(world: &DeferredWorld, entity: Entity) -> Option<(Entity, Entity)> {
@@ -134,255 +145,76 @@ fn joint_discarded<T: Joint>(mut world: DeferredWorld, ctx: HookContext) {
     }
 }
 
-macro_rules! joint_builders {
-    ($name:ident) => {
-        impl $name {
-            /// Places the anchors: on `a` (its shape frame, or a world point for a world
-            /// joint) and on `b` (its shape frame), in m.
-            #[must_use]
-            pub fn with_anchors(mut self, anchor_a: Vec3, anchor_b: Vec3) -> Self {
-                self.bodies.anchor_a = anchor_a;
-                self.bodies.anchor_b = anchor_b;
-                self
-            }
-
-            /// Lets the two bodies collide with each other (by default a joint's bodies do
-            /// not).
-            #[must_use]
-            pub fn with_collision(mut self, collide: bool) -> Self {
-                self.bodies.collide = collide;
-                self
-            }
-        }
-
-        impl Joint for $name {
-            fn bodies(&self) -> &JointBodies {
-                &self.bodies
-            }
-        }
-    };
-}
-
-/// A ball joint: `b`'s anchor stays on `a`'s, every turn is free.
-#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
-#[require(JointImpulse)]
-#[component(on_insert = joint_inserted::<Self>, on_discard = joint_discarded::<Self>)]
-pub struct SphericalJoint {
-    /// The bodies and anchors.
-    pub bodies: JointBodies,
-}
-
-impl SphericalJoint {
-    /// Joins `b` to `a`, both anchors at the bodies' shape-frame origins.
-    #[must_use]
-    pub fn new(a: Entity, b: Entity) -> Self {
-        Self {
-            bodies: JointBodies {
-                a: Some(a),
-                b,
-                anchor_a: Vec3::ZERO,
-                anchor_b: Vec3::ZERO,
-                collide: false,
-            },
-        }
-    }
-
-    /// Joins `b` to the world; place the world point with [`Self::with_anchors`].
-    #[must_use]
-    pub fn to_world(b: Entity) -> Self {
-        Self {
-            bodies: JointBodies {
-                a: None,
-                b,
-                anchor_a: Vec3::ZERO,
-                anchor_b: Vec3::ZERO,
-                collide: false,
-            },
-        }
-    }
-}
-joint_builders!(SphericalJoint);
-
-impl Validate for SphericalJoint {
-    fn validate(&self) -> Result<()> {
-        self.bodies.validate()
-    }
-}
-
-/// A hinge: `b`'s anchor stays on `a`'s and `b`'s hinge axis stays along `a`'s; the turn
-/// about the axis is free.
-#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
-#[require(JointImpulse)]
-#[component(on_insert = joint_inserted::<Self>, on_discard = joint_discarded::<Self>)]
-pub struct RevoluteJoint {
-    /// The bodies and anchors.
-    pub bodies: JointBodies,
-    /// The hinge axis in `a`'s shape frame (world frame for a world joint); unit length.
-    pub axis_a: Vec3,
-    /// The hinge axis in `b`'s shape frame; unit length.
-    pub axis_b: Vec3,
-    /// A motor driving `b`'s turn relative to `a` about the axis, if any.
-    #[serde(default)]
-    pub motor: Option<AngularMotor>,
-}
-
-/// A motor on a hinge: it drives the turn of `b` relative to `a` about the hinge axis (axis
-/// direction, right-handed) towards `target_velocity`, with at most `max_torque`. Solved in
-/// every pass before the joint's other rows, as Box2D solves its motors.
-#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
-pub struct AngularMotor {
-    /// The relative angular velocity it drives towards (rad/s).
-    pub target_velocity: f32,
-    /// The largest torque it exerts (N·m, ≥ 0).
-    pub max_torque: f32,
-}
-
-impl RevoluteJoint {
-    /// Hinges `b` on `a` about `axis` (the same direction in both shape frames: both bodies
-    /// as spawned); anchors at the shape-frame origins.
-    #[must_use]
-    pub fn new(a: Entity, b: Entity, axis: Vec3) -> Self {
-        Self {
-            bodies: SphericalJoint::new(a, b).bodies,
-            axis_a: axis.normalize_or_zero(),
-            axis_b: axis.normalize_or_zero(),
-            motor: None,
-        }
-    }
-
-    /// Hinges `b` to the world about `axis` (world frame, and `b`'s shape frame as spawned
-    /// unturned); place the world point with [`Self::with_anchors`].
-    #[must_use]
-    pub fn to_world(b: Entity, axis: Vec3) -> Self {
-        Self {
-            bodies: SphericalJoint::to_world(b).bodies,
-            axis_a: axis.normalize_or_zero(),
-            axis_b: axis.normalize_or_zero(),
-            motor: None,
-        }
-    }
-
-    /// Drives the hinge towards `target_velocity` (rad/s, `b` relative to `a`, right-handed
-    /// about the axis) with at most `max_torque` (N·m).
-    #[must_use]
-    pub fn with_motor(mut self, target_velocity: f32, max_torque: f32) -> Self {
-        self.motor = Some(AngularMotor {
-            target_velocity,
-            max_torque,
-        });
-        self
-    }
-}
-joint_builders!(RevoluteJoint);
-
-impl Validate for RevoluteJoint {
-    fn validate(&self) -> Result<()> {
-        self.bodies.validate()?;
-        for (what, axis) in [("hinge axis a", self.axis_a), ("hinge axis b", self.axis_b)] {
-            finite_vec(what, axis)?;
-            if (axis.length() - 1.0).abs() > 1e-3 {
-                return Err(Error::OutOfRange {
-                    what,
-                    value: axis.length(),
-                    range: "length 1 (a unit vector)",
-                });
-            }
-        }
-        if let Some(m) = self.motor {
-            crate::core::error::finite("motor target velocity", m.target_velocity)?;
-            crate::core::error::finite("motor max torque", m.max_torque)?;
-            crate::core::error::non_negative("motor max torque", m.max_torque)?;
-        }
-        Ok(())
-    }
-}
-
-/// A weld: `b` keeps its anchor on `a`'s and its rotation relative to `a`.
-#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
-#[require(JointImpulse)]
-#[component(on_insert = joint_inserted::<Self>, on_discard = joint_discarded::<Self>)]
-pub struct FixedJoint {
-    /// The bodies and anchors.
-    pub bodies: JointBodies,
-    /// `b`'s rotation in `a`'s frame (world frame for a world joint) to hold: q_b = q_a · this.
-    pub relative: Quat,
-}
-
-impl FixedJoint {
-    /// Welds `b` to `a` at the relative rotation `relative` (q_b = q_a · relative).
-    #[must_use]
-    pub fn new(a: Entity, b: Entity, relative: Quat) -> Self {
-        Self {
-            bodies: SphericalJoint::new(a, b).bodies,
-            relative,
-        }
-    }
-
-    /// Welds `b` to the world at rotation `rotation`.
-    #[must_use]
-    pub fn to_world(b: Entity, rotation: Quat) -> Self {
-        Self {
-            bodies: SphericalJoint::to_world(b).bodies,
-            relative: rotation,
-        }
-    }
-}
-joint_builders!(FixedJoint);
-
-impl Validate for FixedJoint {
-    fn validate(&self) -> Result<()> {
-        self.bodies.validate()?;
-        crate::rigid::Rotation::try_new(self.relative).map(|_| ())
-    }
-}
-
 /// The impulse a joint applied to `b` in the last substep (`a` took the opposite), kept for
-/// the next substep's warm start.
+/// the next substep's warm start. [`Self::force`] and [`Self::torque`] read the whole joint;
+/// the fields hold its parts.
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
 pub struct JointImpulse {
-    /// Linear impulse at `b`'s anchor (N·s, world frame).
+    /// The locked rows' linear impulse at `b`'s anchor (N·s, world frame).
     pub linear: Vec3,
-    /// Angular impulse about `b`'s anchor (N·m·s, world frame).
+    /// The locked rows' angular impulse (N·m·s, world frame).
     pub angular: Vec3,
     /// The substep length it was applied over (s).
     pub h: f32,
-    /// A hinge motor's angular impulse about the hinge axis (N·m·s).
+    /// The motor's impulse along the free axis (N·m·s for a hinge, N·s for a slider).
     #[serde(default)]
     pub motor: f32,
+    /// The lower limit's impulse along the free axis (≥ 0, towards larger values).
+    #[serde(default)]
+    pub lower: f32,
+    /// The upper limit's impulse along the free axis (≥ 0, towards smaller values).
+    #[serde(default)]
+    pub upper: f32,
+    /// The motor's and limits' impulse as a world vector: linear (N·s; a slider, a distance
+    /// joint) ...
+    #[serde(default)]
+    pub axial_linear: Vec3,
+    /// ... or angular (N·m·s; a hinge).
+    #[serde(default)]
+    pub axial_angular: Vec3,
 }
 
 impl JointImpulse {
-    /// The force the joint exerts on `b` (N, world frame).
+    fn per_second<T: std::ops::Div<f32, Output = T> + Default>(&self, impulse: T) -> T {
+        if self.h > 0.0 {
+            impulse / self.h
+        } else {
+            T::default()
+        }
+    }
+
+    /// The force the joint exerts on `b` (N, world frame), its motor and limits included.
     #[must_use]
     pub fn force(&self) -> Vec3 {
-        if self.h > 0.0 {
-            self.linear / self.h
-        } else {
-            Vec3::ZERO
-        }
+        self.per_second(self.linear + self.axial_linear)
+    }
+
+    /// The torque the joint exerts on `b` about its anchor (N·m, world frame), its motor
+    /// and limits included.
+    #[must_use]
+    pub fn torque(&self) -> Vec3 {
+        self.per_second(self.angular + self.axial_angular)
     }
 
     /// The torque a hinge's motor exerts on `b` about the hinge axis (N·m).
     #[must_use]
     pub fn motor_torque(&self) -> f32 {
-        if self.h > 0.0 {
-            self.motor / self.h
-        } else {
-            0.0
-        }
+        self.per_second(self.motor)
     }
 
-    /// The torque the joint's rows (not its motor) exert on `b` about its anchor (N·m,
-    /// world frame).
+    /// The force a slider's motor exerts on `b` along the axis (N).
     #[must_use]
-    pub fn torque(&self) -> Vec3 {
-        if self.h > 0.0 {
-            self.angular / self.h
-        } else {
-            Vec3::ZERO
-        }
+    pub fn motor_force(&self) -> f32 {
+        self.per_second(self.motor)
+    }
+
+    /// What the limits exert on `b` along the free axis (N or N·m; positive towards larger
+    /// values): nonzero while the joint stands at a limit.
+    #[must_use]
+    pub fn limit_force(&self) -> f32 {
+        self.per_second(self.lower - self.upper)
     }
 }
 

@@ -6,10 +6,15 @@ use glam::{Mat3A, Vec3, Vec3A};
 
 use bevy_platform::collections::HashMap;
 
+use super::axial;
 use super::block::{self, Row};
-use super::solve::{self, Accumulated, Angular, Mode, Rows, Side};
+use super::kinds::{self, Kinds};
+use super::solve::{self, Accumulated, Angular, Linear, Mode, Rows, Side};
 use super::tree::{self, TreeScratch};
-use super::{FixedJoint, JointBodies, JointImpulse, JointSettings, RevoluteJoint, SphericalJoint};
+use super::{
+    DistanceJoint, FixedJoint, JointImpulse, JointSettings, PrismaticJoint, RevoluteJoint,
+    SphericalJoint,
+};
 use crate::core::diagnostics::energy_on;
 use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::Quarantined;
@@ -23,7 +28,8 @@ use crate::integrator::ConstraintsActive;
 use crate::particles::{LinearVelocity, Mass, Position};
 use crate::rigid::{AngularMomentum, AngularVelocity, CenterOfMass, Inertia, Rotation};
 
-/// Solves [`SphericalJoint`], [`RevoluteJoint`] and [`FixedJoint`] entities in the substeps,
+/// Solves [`SphericalJoint`], [`RevoluteJoint`], [`PrismaticJoint`], [`DistanceJoint`] and
+/// [`FixedJoint`] entities in the substeps,
 /// after the contacts in each pass. Its systems run only while a joint exists.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct JointPlugin;
@@ -45,6 +51,8 @@ impl WorldPlugin for JointPlugin {
         crate::core::whole_step::block_on::<SphericalJoint>(world);
         crate::core::whole_step::block_on::<RevoluteJoint>(world);
         crate::core::whole_step::block_on::<FixedJoint>(world);
+        crate::core::whole_step::block_on::<PrismaticJoint>(world);
+        crate::core::whole_step::block_on::<DistanceJoint>(world);
         let any = any_with_component::<JointImpulse>;
         add_own_systems(
             world,
@@ -71,10 +79,7 @@ impl WorldPlugin for JointPlugin {
     }
 }
 
-type JointItem<'a> = (
-    AnyOf<(&'a SphericalJoint, &'a RevoluteJoint, &'a FixedJoint)>,
-    &'a mut JointImpulse,
-);
+type JointItem<'a> = (Kinds<'a>, &'a mut JointImpulse);
 
 type BodyItem<'a> = (
     &'a Position,
@@ -133,35 +138,6 @@ fn relax_joints(
         time.h,
         &mut scratch,
     );
-}
-
-/// The joint's sides and rows.
-fn describe(
-    joint: (
-        Option<&SphericalJoint>,
-        Option<&RevoluteJoint>,
-        Option<&FixedJoint>,
-    ),
-) -> Option<(JointBodies, Angular)> {
-    match joint {
-        (Some(j), _, _) => Some((j.bodies, Angular::Free)),
-        (_, Some(j), _) => Some((
-            j.bodies,
-            Angular::Hinge {
-                axis_a: j.axis_a,
-                axis_b: j.axis_b,
-                motor: j.motor,
-            },
-        )),
-        (_, _, Some(j)) => Some((
-            j.bodies,
-            Angular::Weld {
-                relative: j.relative,
-            },
-        )),
-        // `AnyOf` holds at least one; were it to hold none, the joint is inert.
-        (None, None, None) => None,
-    }
 }
 
 /// A body's side: immovable when it has no mass, is asleep or is not a body at all (the
@@ -283,34 +259,39 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
         // A body that is gone or quarantined leaves the joint inert: its partner runs free
         // (and the joint exerts nothing) until it is back.
         let gone = |e: Entity| !s.index.contains_key(&e) && bodies.get(e).is_err();
-        let described =
-            describe(joint).filter(|(ends, _)| !(ends.a.is_some_and(gone) || gone(ends.b)));
-        let Some((ends, angular)) = described else {
+        let described = kinds::describe(joint)
+            .filter(|j| !(j.bodies().a.is_some_and(gone) || gone(j.bodies().b)));
+        let Some(described) = described else {
             let inert = s.sides.len();
             s.sides.push(Side::WORLD);
             s.coms.push(Vec3::ZERO);
             s.entities.push(None);
             let rows = Rows {
-                local_a: Vec3A::ZERO,
-                local_b: Vec3A::ZERO,
-                angular: Angular::Free,
+                linear: Linear::Free,
+                ..Rows::ball(Vec3A::ZERO, Vec3A::ZERO)
             };
             s.joints.push((rows, inert, inert));
             s.acc.push(Accumulated::default());
             continue;
         };
+        let ends = described.bodies();
         let (ia, local_a) = place(s, bodies, ends.a, ends.anchor_a);
         let (ib, local_b) = place(s, bodies, Some(ends.b), ends.anchor_b);
+        let (angular, linear, free) = described.rows();
         let rows = Rows {
             local_a,
             local_b,
             angular,
+            linear,
+            axial: free,
         };
         s.joints.push((rows, ia, ib));
         s.acc.push(Accumulated {
             linear: impulse.linear.into(),
             angular: impulse.angular.into(),
             motor: impulse.motor,
+            lower: impulse.lower,
+            upper: impulse.upper,
         });
     }
     stiffen_sides(s, joints, h);
@@ -318,12 +299,13 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
         for (j, &(rows, ia, ib)) in s.joints.iter().enumerate() {
             if let Ok([a, b]) = s.sides.get_disjoint_mut([ia, ib]) {
                 solve::warm_start(&rows, &mut s.acc[j], a, b);
+                axial::warm_start(&rows, &s.acc[j], a, b);
             }
         }
     }
-    // Motors first, each on its own (Box2D's order): the rows after them keep what they
-    // leave free, the turn about the hinge.
-    motors(s, h);
+    // Motors and limits first, each on its own (Box2D's order): the rows after them keep
+    // what they leave free, the free axis.
+    free_axes(s, mode, h);
     // Groups: bodies joined through moving bodies (an immovable side joins nothing).
     s.parent.clear();
     s.parent.extend(0..s.sides.len());
@@ -356,7 +338,7 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
         let end = k + s.order[k..].iter().take_while(|o| o.0 == group).count();
         let count: usize = s.order[k..end]
             .iter()
-            .map(|&(_, j)| s.joints[j].0.angular.rows() + 3)
+            .map(|&(_, j)| s.joints[j].0.count())
             .sum();
         if count <= block::MAX_GROUP_ROWS || mostly_tree(s, k, end) {
             s.rows.clear();
@@ -375,9 +357,11 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
             for i in k..end {
                 let (rows, ia, ib) = s.joints[s.order[i].1];
                 let j = s.order[i].1;
-                if let (Angular::Free, Ok([a, b])) =
-                    (rows.angular, s.sides.get_disjoint_mut([ia, ib]))
-                {
+                if let (Angular::Free, Linear::Point, Ok([a, b])) = (
+                    rows.angular,
+                    rows.linear,
+                    s.sides.get_disjoint_mut([ia, ib]),
+                ) {
                     solve::solve_ball(&rows, a, b, &mut s.acc[j], mode);
                     continue;
                 }
@@ -391,12 +375,16 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     for (side, &e) in s.sides.iter().zip(&s.entities) {
         store(bodies, e, side);
     }
-    for ((_, mut impulse), acc) in joints.iter_mut().zip(&s.acc) {
+    for (((_, mut impulse), acc), &(rows, ia, ib)) in joints.iter_mut().zip(&s.acc).zip(&s.joints) {
         // Bookkeeping, not a change anyone listens for.
         let impulse = impulse.bypass_change_detection();
         impulse.linear = acc.linear.into();
         impulse.angular = acc.angular.into();
         impulse.motor = acc.motor;
+        impulse.lower = acc.lower;
+        impulse.upper = acc.upper;
+        (impulse.axial_linear, impulse.axial_angular) =
+            axial::world_impulse(&rows, acc, &s.sides[ia], &s.sides[ib]);
         impulse.h = h;
     }
 }
@@ -430,13 +418,13 @@ fn stiffen_sides(s: &mut Scratch, joints: &Joints, h: f32) {
     }
 }
 
-/// Drives every hinge motor, each on its own.
-fn motors(s: &mut Scratch, h: f32) {
+/// Solves every free axis's motor and limits, each joint on its own.
+fn free_axes(s: &mut Scratch, mode: Mode, h: f32) {
     for (j, &(rows, ia, ib)) in s.joints.iter().enumerate() {
-        if let Angular::Hinge { motor: Some(_), .. } = rows.angular
+        if rows.axial.active()
             && let Ok([a, b]) = s.sides.get_disjoint_mut([ia, ib])
         {
-            solve::solve_motor(&rows, a, b, &mut s.acc[j], h);
+            axial::solve(&rows, a, b, &mut s.acc[j], mode, h);
         }
     }
 }

@@ -10,7 +10,6 @@
 
 use glam::{Mat3A, Quat, Vec3, Vec3A};
 
-use super::AngularMotor;
 use crate::collision::solver::Softness;
 
 /// One side of a joint during a pass.
@@ -47,7 +46,7 @@ impl Side {
 
     /// Takes the linear impulse `p` at lever arm `r` and the angular impulse `l`.
     #[inline]
-    fn push(&mut self, p: Vec3A, r: Vec3A, l: Vec3A) {
+    pub fn push(&mut self, p: Vec3A, r: Vec3A, l: Vec3A) {
         if !self.moves {
             return;
         }
@@ -63,12 +62,8 @@ impl Side {
 pub(super) enum Angular {
     /// Nothing: a ball joint.
     Free,
-    /// The hinge axes (each side's shape frame) aligned, and the hinge's motor.
-    Hinge {
-        axis_a: Vec3,
-        axis_b: Vec3,
-        motor: Option<AngularMotor>,
-    },
+    /// The hinge axes (each side's shape frame) aligned.
+    Hinge { axis_a: Vec3, axis_b: Vec3 },
     /// q_b = q_a · relative.
     Weld { relative: Quat },
 }
@@ -84,6 +79,63 @@ impl Angular {
     }
 }
 
+/// Which free axis.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Axis {
+    /// The turn of `b` relative to `a` about the hinge axis (rad).
+    Turn { axis_a: Vec3, axis_b: Vec3 },
+    /// The offset of `b`'s anchor from `a`'s along `a`'s axis (m).
+    Slide { axis_a: Vec3 },
+    /// The distance between the anchors (m).
+    Length,
+}
+
+/// A joint's free axis with its limits and motor, if it has one.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Axial {
+    pub axis: Option<Axis>,
+    /// `min ≤ value ≤ max`.
+    pub limits: Option<(f32, f32)>,
+    /// Target rate (rad/s or m/s) and largest force or torque (N or N·m).
+    pub motor: Option<(f32, f32)>,
+}
+
+impl Axial {
+    /// No free axis with rows of its own (a ball joint, a weld).
+    pub const NONE: Self = Self {
+        axis: None,
+        limits: None,
+        motor: None,
+    };
+
+    /// Whether it has any row to solve.
+    pub fn active(&self) -> bool {
+        self.axis.is_some() && (self.limits.is_some() || self.motor.is_some())
+    }
+}
+
+/// What a joint holds of its anchors' separation.
+#[derive(Debug, Clone, Copy)]
+pub(super) enum Linear {
+    /// All three components: the anchors together.
+    Point,
+    /// The two perpendicular to `a`'s axis (its shape frame): a slider.
+    Slide { axis_a: Vec3 },
+    /// None (a distance joint holds its length with its axial rows alone).
+    Free,
+}
+
+impl Linear {
+    /// Its rows: three, two or none.
+    pub fn rows(&self) -> usize {
+        match self {
+            Linear::Point => 3,
+            Linear::Slide { .. } => 2,
+            Linear::Free => 0,
+        }
+    }
+}
+
 /// A joint's geometry for one pass: lever arms in the world frame.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Rows {
@@ -91,6 +143,27 @@ pub(super) struct Rows {
     pub local_a: Vec3A,
     pub local_b: Vec3A,
     pub angular: Angular,
+    pub linear: Linear,
+    /// The free axis's limits and motor.
+    pub axial: Axial,
+}
+
+impl Rows {
+    /// A ball joint's rows between the anchors `local_a` and `local_b`.
+    pub fn ball(local_a: Vec3A, local_b: Vec3A) -> Self {
+        Self {
+            local_a,
+            local_b,
+            angular: Angular::Free,
+            linear: Linear::Point,
+            axial: Axial::NONE,
+        }
+    }
+
+    /// The rows solved together with other joints' (all but the axial ones).
+    pub fn count(&self) -> usize {
+        self.angular.rows() + self.linear.rows()
+    }
 }
 
 /// The accumulated impulses applied to `b` (and their opposite to `a`).
@@ -98,8 +171,12 @@ pub(super) struct Rows {
 pub(super) struct Accumulated {
     pub linear: Vec3A,
     pub angular: Vec3A,
-    /// A hinge motor's impulse about the hinge axis (N·m·s).
+    /// The motor's impulse along the free axis (N·s or N·m·s).
     pub motor: f32,
+    /// The lower and upper limits' impulses along the free axis (each ≥ 0, pushing away
+    /// from its limit).
+    pub lower: f32,
+    pub upper: f32,
 }
 
 /// [`Softness`] for a biased pass, or the rigid solve of a relax pass.
@@ -134,54 +211,29 @@ fn arms(rows: &Rows, a: &Side, b: &Side) -> (Vec3A, Vec3A, Vec3A) {
     (r_a, r_b, (b.x + r_b) - (a.x + r_a))
 }
 
+/// The lever arm of the linear rows on `a`: to its anchor, or for a slider to `b`'s anchor
+/// (where the slider's rows act on the rail).
+#[inline]
+pub(super) fn lever_a(rows: &Rows, r_a: Vec3A, gap: Vec3A) -> Vec3A {
+    match rows.linear {
+        Linear::Slide { .. } => r_a + gap,
+        _ => r_a,
+    }
+}
+
 /// Applies the accumulated impulses again (the warm start of a substep). A hinge's angular
 /// impulse is first projected off its axis as it now stands: it was found perpendicular to
 /// the axis of the last substep, and the part of it along the turned axis would spin the
 /// hinge, which its rows leave free (a spinning wheel on a swinging arm gained speed that
 /// way, past what its motor could hold).
 pub(super) fn warm_start(rows: &Rows, acc: &mut Accumulated, a: &mut Side, b: &mut Side) {
-    let (r_a, r_b, _) = arms(rows, a, b);
-    let motor = match rows.angular {
-        Angular::Hinge { axis_a, .. } => {
-            let axis = a.q * Vec3A::from(axis_a);
-            acc.angular -= axis * axis.dot(acc.angular);
-            acc.motor * axis
-        }
-        _ => Vec3A::ZERO,
-    };
-    a.push(-acc.linear, r_a, -acc.angular - motor);
-    b.push(acc.linear, r_b, acc.angular + motor);
-}
-
-/// Drives a hinge's motor one step: the relative turn rate about the axis (a's axis in the
-/// world) towards the target, the accumulated impulse kept within ±max_torque · h. Rigid in
-/// every pass: a motor is a velocity target, with nothing to correct at the position level.
-pub(super) fn solve_motor(rows: &Rows, a: &mut Side, b: &mut Side, acc: &mut Accumulated, h: f32) {
-    let Angular::Hinge {
-        axis_a,
-        motor: Some(motor),
-        ..
-    } = rows.angular
-    else {
-        return;
-    };
-    let axis = a.q * Vec3A::from(axis_a);
-    let mut k = 0.0;
-    for side in [&*a, &*b] {
-        if side.moves {
-            k += axis.dot(side.inv_i * axis);
-        }
+    let (r_a, r_b, gap) = arms(rows, a, b);
+    if let Angular::Hinge { axis_a, .. } = rows.angular {
+        let axis = a.q * Vec3A::from(axis_a);
+        acc.angular -= axis * axis.dot(acc.angular);
     }
-    if !(k > 0.0 && k.is_finite()) {
-        return;
-    }
-    let rate = (b.w - a.w).dot(axis);
-    let limit = motor.max_torque * h;
-    let held = acc.motor;
-    acc.motor = (held - (rate - motor.target_velocity) / k).clamp(-limit, limit);
-    let lambda = acc.motor - held;
-    a.push(Vec3A::ZERO, Vec3A::ZERO, -lambda * axis);
-    b.push(Vec3A::ZERO, Vec3A::ZERO, lambda * axis);
+    a.push(-acc.linear, lever_a(rows, r_a, gap), -acc.angular);
+    b.push(acc.linear, r_b, acc.angular);
 }
 
 /// Solves a ball joint's three rows on their own: K λ = −S_m (Ċ + β C) − S_i λ_acc with

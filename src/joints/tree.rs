@@ -474,11 +474,7 @@ mod tests {
             body(Vec3A::new(-0.5, 0.2, 0.0), 1.0, Vec3A::ZERO),
             body(Vec3A::new(0.9, 0.2, 0.0), 2.0, Vec3A::new(0.0, 5.0, 1.0)),
         ];
-        let ball = |a: Vec3A, b: Vec3A| Rows {
-            local_a: a,
-            local_b: b,
-            angular: Angular::Free,
-        };
+        let ball = |a: Vec3A, b: Vec3A| Rows::ball(a, b);
         let joints = [
             (
                 0,
@@ -512,7 +508,6 @@ mod tests {
                     angular: Angular::Hinge {
                         axis_a: Vec3::Z,
                         axis_b: Vec3::Z,
-                        motor: None,
                     },
                     ..ball(Vec3A::new(0.2, 0.0, 0.0), Vec3A::new(-0.2, 0.0, 0.0))
                 },

@@ -1,5 +1,18 @@
 //! Joints against closed forms, at the defaults.
 
 mod hard_cases;
+mod limits;
 mod motors;
 mod pendulums;
+
+/// Why the entity `e` is quarantined: its input error as text.
+fn quarantine_reason(world: &bevy_ecs::world::World, e: bevy_ecs::entity::Entity) -> String {
+    use hooke::core::quarantine::QuarantineReason;
+    match world
+        .get::<hooke::prelude::Quarantined>(e)
+        .map(|q| &q.reason)
+    {
+        Some(QuarantineReason::InvalidInput(error)) => error.to_string(),
+        other => format!("not quarantined for its input: {other:?}"),
+    }
+}

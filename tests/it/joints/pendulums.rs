@@ -431,10 +431,7 @@ fn a_joint_with_a_bad_input_is_quarantined_with_its_reason() {
     world.step_physics();
     let reasons: Vec<String> = cases
         .iter()
-        .map(|&j| match &world.get::<Quarantined>(j).unwrap().reason {
-            QuarantineReason::InvalidInput(e) => e.to_string(),
-            other => panic!("{other:?}"),
-        })
+        .map(|&j| super::quarantine_reason(&world, j))
         .collect();
     assert!(reasons[0].contains("itself"), "{}", reasons[0]);
     assert!(reasons[1].contains("hinge axis b"), "{}", reasons[1]);
@@ -442,4 +439,52 @@ fn a_joint_with_a_bad_input_is_quarantined_with_its_reason() {
     assert!(reasons[3].contains("motor max torque"), "{}", reasons[3]);
     // The body itself runs on.
     assert!(world.get::<Quarantined>(body).is_none());
+}
+
+#[test]
+fn a_ball_on_a_spherical_joint_circles_as_a_conical_pendulum() {
+    // A ball (r = 0.1 m) hung by a ball joint from a point d = 1 m above its centre, set
+    // turning about the vertical at Ω with its string α from it. A ball's inertia is the
+    // same about every axis, so the steady cone is the point pendulum's: Ω² = g / (d cos α).
+    for alpha in [20_f32.to_radians(), 60_f32.to_radians()] {
+        let mut world = default_world();
+        let pivot = Vec3A::new(0.0, 3.0, 0.0);
+        let d = 1.0_f32;
+        let omega = (9.81 / (d * alpha.cos())).sqrt();
+        let x = pivot + Vec3A::new(d * alpha.sin(), -d * alpha.cos(), 0.0);
+        let spin = Vec3A::new(0.0, omega, 0.0);
+        let ball = world
+            .spawn((
+                RigidBody::Dynamic,
+                Collider::ball(0.1).unwrap(),
+                Position(x),
+                LinearVelocity(spin.cross(x - pivot)),
+                AngularVelocity(spin),
+            ))
+            .id();
+        // Anchored at the pivot, d from the ball's centre: the rod is the ball's own lever.
+        world.spawn(SphericalJoint::to_world(ball).with_anchors(pivot.into(), (pivot - x).into()));
+        let (mut azimuth, mut last, mut widest) = (0.0_f32, 0.0_f32, 0.0_f32);
+        let steps = 600;
+        for _ in 0..steps {
+            world.step_physics();
+            let r = world.get::<Position>(ball).unwrap().0 - pivot;
+            let now = (-r.z).atan2(r.x);
+            azimuth += (now - last + std::f32::consts::PI).rem_euclid(std::f32::consts::TAU)
+                - std::f32::consts::PI;
+            last = now;
+            let cone = (r.x.hypot(r.z)).atan2(-r.y);
+            widest = widest.max((cone - alpha).abs());
+        }
+        let rate = azimuth / (steps as f32 / 60.0);
+        assert!(
+            widest < 0.01,
+            "the cone opened or closed by {widest} rad from {alpha}"
+        );
+        assert!(
+            (rate / omega - 1.0).abs() < 0.002,
+            "α {alpha}: {rate} rad/s about the vertical, closed form {omega}"
+        );
+        assert!(world.get::<Quarantined>(ball).is_none());
+    }
 }
