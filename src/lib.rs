@@ -207,6 +207,8 @@ pub mod prelude {
     pub use crate::joints::AngularMotor;
     pub use crate::joints::DistanceJoint;
     pub use crate::joints::FixedJoint;
+    pub use crate::joints::JointBreakForce;
+    pub use crate::joints::JointBroken;
     pub use crate::joints::JointDiagnostics;
     pub use crate::joints::JointImpulse;
     pub use crate::joints::JointLimits;

@@ -138,6 +138,7 @@ fn register_messages(world: &mut World) {
     MessageRegistry::register_message::<ContactStarted>(world);
     MessageRegistry::register_message::<ContactEnded>(world);
     MessageRegistry::register_message::<BodyQuarantined>(world);
+    MessageRegistry::register_message::<crate::joints::JointBroken>(world);
     MessageRegistry::register_message::<crate::integrator::StabilityWarning>(world);
     MessageRegistry::register_message::<crate::core::restore::ResourceRestored>(world);
     MessageRegistry::register_message::<crate::core::restore::InvalidSetting>(world);

@@ -65,12 +65,14 @@
 
 mod axial;
 mod block;
+mod breaking;
 mod diagnostics;
 mod kinds;
 mod plugin;
 mod solve;
 mod tree;
 
+pub use breaking::{JointBreakForce, JointBroken};
 pub use diagnostics::JointDiagnostics;
 pub use kinds::{
     AngularMotor, DistanceJoint, FixedJoint, JointLimits, LinearMotor, PrismaticJoint,

@@ -20,8 +20,8 @@ use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::Quarantined;
 use crate::core::rest::Sleeping;
 use crate::core::schedule::{
-    CollisionSystems, MeasureSystems, PhysicsSchedule, PrepareSystems, RelaxSystems, StepSystems,
-    SubstepSchedule, add_own_systems,
+    CollisionSystems, FinishSystems, MeasureSystems, PhysicsSchedule, PhysicsSystems,
+    PrepareSystems, RelaxSystems, StepSystems, SubstepSchedule, add_own_systems,
 };
 use crate::core::time::SubstepTime;
 use crate::integrator::ConstraintsActive;
@@ -46,6 +46,15 @@ impl WorldPlugin for JointPlugin {
             ),
         );
         crate::core::restore::init::<JointSettings>(world);
+        crate::core::plugin::add_message::<super::JointBroken>(world);
+        add_own_systems(
+            world,
+            PhysicsSchedule,
+            super::breaking::break_joints
+                .run_if(any_with_component::<super::JointBreakForce>)
+                .in_set(PhysicsSystems::Finish)
+                .before(FinishSystems::Diagnostics),
+        );
         crate::core::restore::init::<super::JointDiagnostics>(world);
         // The whole-step path knows no joints: worlds with one take the schedule.
         crate::core::whole_step::block_on::<SphericalJoint>(world);

@@ -373,3 +373,68 @@ fn a_joint_with_bad_limits_or_axes_is_quarantined_with_its_reason() {
     }
     assert_live(&world, &[body]);
 }
+
+#[test]
+fn a_joint_breaks_past_its_force_says_so_once_and_lets_go() {
+    // A 10 kg ball (r 0.134 m) hangs on a ball joint rated 150 N: its weight (98.1 N) holds.
+    // After 1 s a 100 N pull down is added (198.1 N): the joint breaks in that step, says so
+    // once, and the ball falls at g + 10 m/s².
+    let mut world = default_world();
+    let radius = (10.0 / (1000.0 * 4.0 / 3.0 * std::f32::consts::PI)).cbrt();
+    let ball = world
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::ball(radius).unwrap(),
+            Position(Vec3A::new(0.0, 3.0, 0.0)),
+        ))
+        .id();
+    let joint = world
+        .spawn((
+            SphericalJoint::to_world(ball).with_anchors(Vec3::new(0.0, 3.5, 0.0), Vec3::Y * 0.5),
+            JointBreakForce::new(150.0),
+        ))
+        .id();
+    let mut reports = Vec::new();
+    let read = |world: &World, reports: &mut Vec<JointBroken>| {
+        let messages = world.resource::<Messages<JointBroken>>();
+        reports.extend(messages.iter_current_update_messages().copied());
+    };
+    for _ in 0..60 {
+        world.step_physics();
+        read(&world, &mut reports);
+    }
+    assert!(reports.is_empty(), "{reports:?}");
+    assert!(world.get::<SphericalJoint>(joint).is_some());
+    world
+        .entity_mut(ball)
+        .insert(hooke::particles::ExternalForce(Vec3::new(0.0, -100.0, 0.0)));
+    world.step_physics();
+    read(&world, &mut reports);
+    assert_eq!(reports.len(), 1, "{reports:?}");
+    assert_eq!(reports[0].joint, joint);
+    let pull = reports[0].force.y;
+    assert!((pull - 198.1).abs() < 2.0, "broke carrying {pull} N");
+    assert!(world.get::<SphericalJoint>(joint).is_none());
+    let v0 = velocity(&world, ball).y;
+    for _ in 0..30 {
+        world.step_physics();
+        read(&world, &mut reports);
+    }
+    assert_eq!(reports.len(), 1, "reported again: {reports:?}");
+    let fall = v0 - velocity(&world, ball).y;
+    assert!(
+        (fall - (G + 10.0) * 0.5).abs() < 1e-3,
+        "gained {fall} m/s in 0.5 s"
+    );
+    assert_live(&world, &[ball, joint]);
+    // A bad threshold is a typed error, not a joint that never (or always) breaks.
+    let bad = world
+        .spawn((
+            SphericalJoint::to_world(ball),
+            JointBreakForce::new(f32::NAN),
+        ))
+        .id();
+    world.step_physics();
+    let reason = super::quarantine_reason(&world, bad);
+    assert!(reason.contains("joint break force"), "{reason}");
+}
