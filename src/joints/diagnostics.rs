@@ -102,15 +102,7 @@ pub(super) fn measure_joints(
         ) else {
             continue;
         };
-        let (angular, linear, axial) = joint.rows();
-        let rows = Rows {
-            local_a,
-            local_b,
-            angular,
-            linear,
-            axial,
-        };
-        let (gap, angle) = errors(&rows, &a, &b);
+        let (gap, angle) = errors(&joint.rows_at(local_a, local_b), &a, &b);
         d.joints += 1;
         if gap > d.largest_gap || d.widest.is_none() {
             d.largest_gap = gap;

@@ -1,9 +1,9 @@
 //! The joint kinds, their motors and limits.
 
 use bevy_ecs::prelude::*;
-use glam::{Quat, Vec3};
+use glam::{Quat, Vec3, Vec3A};
 
-use super::solve::{Angular, Axial, Axis, Linear};
+use super::solve::{Angular, Axial, Axis, Linear, Rows};
 use super::{Joint, JointBodies, JointImpulse, joint_discarded, joint_inserted};
 use crate::core::error::{Error, Result, finite, finite_vec, non_negative};
 use crate::core::quarantine::Validate;
@@ -13,6 +13,18 @@ pub(super) trait Describe {
     fn bodies(&self) -> &JointBodies;
     /// Its locked angular rows, locked linear rows, and free axis.
     fn rows(&self) -> (Angular, Linear, Axial);
+
+    /// Its rows with the anchors `local_a`, `local_b` measured from the centres of mass.
+    fn rows_at(&self, local_a: Vec3A, local_b: Vec3A) -> Rows {
+        let (angular, linear, axial) = self.rows();
+        Rows {
+            local_a,
+            local_b,
+            angular,
+            linear,
+            axial,
+        }
+    }
 }
 
 impl<T: Describe + Component + Validate> Joint for T {}

@@ -286,15 +286,7 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
         let ends = described.bodies();
         let (ia, local_a) = place(s, bodies, ends.a, ends.anchor_a);
         let (ib, local_b) = place(s, bodies, Some(ends.b), ends.anchor_b);
-        let (angular, linear, free) = described.rows();
-        let rows = Rows {
-            local_a,
-            local_b,
-            angular,
-            linear,
-            axial: free,
-        };
-        s.joints.push((rows, ia, ib));
+        s.joints.push((described.rows_at(local_a, local_b), ia, ib));
         s.acc.push(Accumulated {
             linear: impulse.linear.into(),
             angular: impulse.angular.into(),
