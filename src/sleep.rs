@@ -14,6 +14,10 @@
 //! position, rotation or velocity, or by adding an external force, torque or impulse; or by
 //! removing [`Sleeping`] directly.
 //!
+//! **Joints** join islands as contacts do: a jointed chain sleeps whole and wakes whole, a
+//! body jointed to a moving kinematic body (or to a body that never sleeps) stays awake, and
+//! putting a joint on or taking one off (breaking it included) wakes its bodies.
+//!
 //! Particles, meshes and bodies attached to springs never sleep: springs act only between
 //! awake bodies, and a spring's pull is not a contact that the islands could see.
 
@@ -26,6 +30,7 @@ use crate::core::plugin::WorldPlugin;
 use crate::core::quarantine::Quarantined;
 use crate::core::schedule::{CollisionSystems, PhysicsSchedule, PrepareSystems, add_own_systems};
 use crate::core::time::PhysicsTime;
+use crate::joints::{self, Kinds};
 use crate::particles::{ExternalForce, ExternalImpulse, LinearVelocity, Mass, Position};
 use crate::rigid::{
     AngularMomentum, AngularVelocity, ExternalForceAtPoint, ExternalImpulseAtPoint, ExternalTorque,
@@ -183,6 +188,7 @@ fn wake_on_structural_change(
 /// impact: a ball fired at a sleeping box stopped dead and the box never moved.) Runs
 /// between the narrow phase and the contact constraints; its removals of [`Sleeping`] are
 /// applied before the constraints are built.
+#[allow(clippy::too_many_arguments)] // system parameters: queries and resources
 fn wake_hit_islands(
     mut commands: Commands,
     time: Res<PhysicsTime>,
@@ -191,10 +197,21 @@ fn wake_hit_islands(
     sleepers: Query<(), With<Sleeping>>,
     movers: Query<(&LinearVelocity, Option<&Mass>), Without<Sleeping>>,
     mut timers: Query<&mut SleepTimer>,
+    jointed: Query<Kinds, Without<Quarantined>>,
 ) {
     let (dt, touch) = (time.dt(), 0.25 * settings.margin);
     let mut woken = Vec::new();
     let mut asleep_pairs = Vec::new();
+    // A joint between two sleepers carries the waking as a touching contact does.
+    let mut asleep_joints = Vec::new();
+    for j in &jointed {
+        if let Some(&joints::JointBodies { a: Some(a), b, .. }) = joints::bodies(j)
+            && sleepers.contains(a)
+            && sleepers.contains(b)
+        {
+            asleep_joints.push((a.min(b), a.max(b)));
+        }
+    }
     // The broad phase pairs a sleeper with nothing static either: (sleeper, pair).
     let mut grounded = Vec::new();
     for (&(a, b), state) in contacts.pairs.iter() {
@@ -233,14 +250,15 @@ fn wake_hit_islands(
     if woken.is_empty() {
         return;
     }
-    // The whole island wakes: spread over the touching pairs of sleepers.
+    // The whole island wakes: spread over the touching pairs and the joints of sleepers.
     woken.sort_unstable();
     woken.dedup();
     asleep_pairs.sort_unstable();
+    asleep_joints.sort_unstable();
     let mut grew = true;
     while grew {
         grew = false;
-        for &(a, b) in &asleep_pairs {
+        for &(a, b) in asleep_pairs.iter().chain(&asleep_joints) {
             let (ia, ib) = (woken.binary_search(&a), woken.binary_search(&b));
             let new = match (ia, ib) {
                 (Ok(_), Err(at)) => Some((b, at)),
@@ -302,7 +320,36 @@ struct IslandScratch {
     entities: Vec<Entity>,
     parent: Vec<usize>,
     island_still: Vec<bool>,
+    moving_pinned: Vec<Entity>,
 }
+
+/// What holds one side of a joint, as the islands see it.
+enum JointSide {
+    /// A body of the islands.
+    Island(usize),
+    /// The world, a pinned body at rest, or a body gone or quarantined (the joint is inert).
+    Still,
+    /// A moving kinematic body, or a dynamic body that never sleeps (one without a collider of
+    /// its own): its partner stays awake.
+    Moving,
+}
+
+/// Bodies outside the islands, read for the joints they hold (disjoint from [`SleepFilter`]).
+type Outsiders<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Option<&'static Mass>,
+        Option<&'static LinearVelocity>,
+        Option<&'static AngularVelocity>,
+        Has<Quarantined>,
+    ),
+    Or<(
+        Without<Collider>,
+        With<Quarantined>,
+        With<crate::collision::ColliderOf>,
+    )>,
+>;
 
 /// Colliders that sleep on their own: not quarantined, not a part of another body.
 type SleepFilter = (
@@ -319,6 +366,8 @@ fn update_islands(
     time: Res<PhysicsTime>,
     contacts: Res<Contacts>,
     springs: Query<&Spring>,
+    jointed: Query<Kinds, Without<Quarantined>>,
+    outsiders: Outsiders,
     sleepers: Query<Entity, With<Sleeping>>,
     mut bodies: Query<SleepBody, SleepFilter>,
     mut scratch: Local<IslandScratch>,
@@ -338,13 +387,18 @@ fn update_islands(
         entities,
         parent,
         island_still,
+        moving_pinned,
     } = &mut *scratch;
     index.clear();
     still.clear();
     asleep.clear();
     entities.clear();
+    moving_pinned.clear();
     for (e, m, v, w, _, mut timer, sleeping, disabled) in &mut bodies {
         if m.is_pinned() {
+            if v.0 != glam::Vec3A::ZERO || w.is_some_and(|w| w.0 != glam::Vec3A::ZERO) {
+                moving_pinned.push(e);
+            }
             continue;
         }
         let slow =
@@ -372,12 +426,51 @@ fn update_islands(
     }
     parent.clear();
     parent.extend(0..entities.len());
+    let union = |parent: &mut Vec<usize>, i: usize, j: usize| {
+        let (ri, rj) = (find(parent, i), find(parent, j));
+        if ri != rj {
+            parent[ri.max(rj)] = ri.min(rj);
+        }
+    };
     for (a, b) in contacts.touching() {
         if let (Some(&i), Some(&j)) = (index.get(&a), index.get(&b)) {
-            let (ri, rj) = (find(parent, i), find(parent, j));
-            if ri != rj {
-                parent[ri.max(rj)] = ri.min(rj);
+            union(parent, i, j);
+        }
+    }
+    let side = |e: Option<Entity>| -> JointSide {
+        let Some(e) = e else {
+            return JointSide::Still;
+        };
+        if let Some(&i) = index.get(&e) {
+            return JointSide::Island(i);
+        }
+        if moving_pinned.contains(&e) {
+            return JointSide::Moving;
+        }
+        match outsiders.get(e) {
+            Ok((_, _, _, true)) | Err(_) => JointSide::Still,
+            Ok((mass, v, w, false)) => {
+                let moves = v.is_some_and(|v| v.0 != glam::Vec3A::ZERO)
+                    || w.is_some_and(|w| w.0 != glam::Vec3A::ZERO);
+                if moves || mass.is_some_and(|m| !m.is_pinned()) {
+                    JointSide::Moving
+                } else {
+                    JointSide::Still
+                }
             }
+        }
+    };
+    for j in &jointed {
+        let Some(bodies) = joints::bodies(j) else {
+            continue;
+        };
+        match (side(bodies.a), side(Some(bodies.b))) {
+            (JointSide::Island(i), JointSide::Island(k)) => union(parent, i, k),
+            (JointSide::Island(i), JointSide::Moving)
+            | (JointSide::Moving, JointSide::Island(i)) => {
+                still[i] = false;
+            }
+            _ => {}
         }
     }
     island_still.clear();

@@ -31,3 +31,16 @@ pub type Simulated = (
     Without<crate::core::quarantine::Quarantined>,
     Without<Sleeping>,
 );
+
+/// Wakes `e` if it sleeps, with its stillness count started afresh (or it would fall
+/// straight back asleep). For the structural changes that wake a body: a joint added to it
+/// or taken off it.
+pub(crate) fn wake(world: &mut bevy_ecs::world::DeferredWorld, e: Entity) {
+    if world.get::<Sleeping>(e).is_some() {
+        world
+            .commands()
+            .entity(e)
+            .try_remove::<Sleeping>()
+            .try_insert(SleepTimer(0.0));
+    }
+}

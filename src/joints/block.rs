@@ -35,6 +35,9 @@ pub(super) struct Row {
     pub linear: bool,
     /// Position error (m or rad).
     pub c: f32,
+    /// The row's speed from its immovable sides (m/s or rad/s): a kinematic body moves the
+    /// anchor it holds, and the rows must follow it.
+    pub carried: f32,
 }
 
 /// The rows of one joint between sides `a` and `b` (indices into the pass's bodies; `None`
@@ -57,7 +60,9 @@ pub(super) fn joint_rows(
         dir: Vec3A::ZERO,
         linear: false,
         c: 0.0,
+        carried: 0.0,
     };
+    let start = out.len();
     let angular = |d: Vec3A, c: f32| Row {
         ang_a: -d,
         ang_b: d,
@@ -111,6 +116,14 @@ pub(super) fn joint_rows(
             linear(v.into());
         }
         Linear::Free => {}
+    }
+    for row in &mut out[start..] {
+        if ia.is_none() {
+            row.carried += row.lin_a.dot(a.v) + row.ang_a.dot(a.w);
+        }
+        if ib.is_none() {
+            row.carried += row.lin_b.dot(b.v) + row.ang_b.dot(b.w);
+        }
     }
 }
 
@@ -166,7 +179,7 @@ pub(super) fn target(rp: &Row, bodies: &[Side], mode: Mode) -> f64 {
     let speed = |body: Option<usize>, lin: Vec3A, ang: Vec3A| {
         body.map_or(0.0, |s| lin.dot(bodies[s].v) + ang.dot(bodies[s].w))
     };
-    let cdot = speed(rp.a, rp.lin_a, rp.ang_a) + speed(rp.b, rp.lin_b, rp.ang_b);
+    let cdot = speed(rp.a, rp.lin_a, rp.ang_a) + speed(rp.b, rp.lin_b, rp.ang_b) + rp.carried;
     f64::from(-mode.mass_scale * (cdot + mode.bias_rate * rp.c))
 }
 

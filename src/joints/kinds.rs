@@ -510,7 +510,7 @@ impl Validate for FixedJoint {
 }
 
 /// The joint kinds a query reads at once.
-pub(super) type Kinds<'a> = AnyOf<(
+pub(crate) type Kinds<'a> = AnyOf<(
     &'a SphericalJoint,
     &'a RevoluteJoint,
     &'a FixedJoint,
@@ -519,7 +519,7 @@ pub(super) type Kinds<'a> = AnyOf<(
 )>;
 
 /// What a query over [`Kinds`] yields.
-pub(super) type KindsItem<'a> = (
+pub(crate) type KindsItem<'a> = (
     Option<&'a SphericalJoint>,
     Option<&'a RevoluteJoint>,
     Option<&'a FixedJoint>,
@@ -537,4 +537,9 @@ pub(super) fn describe(kinds: KindsItem<'_>) -> Option<&'_ dyn Describe> {
         (.., Some(j)) => Some(j),
         _ => None,
     }
+}
+
+/// The sides of the joint an [`AnyOf`] over [`Kinds`] holds.
+pub(crate) fn bodies(kinds: KindsItem<'_>) -> Option<&'_ JointBodies> {
+    describe(kinds).map(Describe::bodies)
 }

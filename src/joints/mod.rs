@@ -78,6 +78,7 @@ pub use kinds::{
     AngularMotor, DistanceJoint, FixedJoint, JointLimits, LinearMotor, PrismaticJoint,
     RevoluteJoint, SphericalJoint,
 };
+pub(crate) use kinds::{Kinds, bodies};
 pub use plugin::JointPlugin;
 
 use bevy_ecs::prelude::*;
@@ -127,10 +128,22 @@ fn excluded_pair<T: Joint>(world: &DeferredWorld, entity: Entity) -> Option<(Ent
     }
 }
 
-/// Insert hook: validates the joint (quarantining it on a bad input) and keeps its bodies
-/// from colliding.
+/// Wakes the bodies of the joint on `entity`: a joint put on or taken off a sleeping body
+/// changes what holds it.
+fn wake_sides<T: Joint>(world: &mut DeferredWorld, entity: Entity) {
+    let Some(bodies) = world.get::<T>(entity).map(|j| *j.bodies()) else {
+        return;
+    };
+    for e in bodies.a.into_iter().chain([bodies.b]) {
+        crate::core::rest::wake(world, e);
+    }
+}
+
+/// Insert hook: validates the joint (quarantining it on a bad input), keeps its bodies
+/// from colliding and wakes them.
 fn joint_inserted<T: Joint>(mut world: DeferredWorld, ctx: HookContext) {
     validate_on_insert::<T>(world.reborrow(), ctx);
+    wake_sides::<T>(&mut world, ctx.entity);
     if let Some((a, b)) = excluded_pair::<T>(&world, ctx.entity)
         && let Some(mut excluded) = world.get_resource_mut::<crate::collision::PairExclusions>()
     {
@@ -138,8 +151,10 @@ fn joint_inserted<T: Joint>(mut world: DeferredWorld, ctx: HookContext) {
     }
 }
 
-/// Discard hook (a new value, a removal, a despawn): the old value's bodies may collide again.
+/// Discard hook (a new value, a removal, a despawn, a break): the old value's bodies may
+/// collide again, and wake.
 fn joint_discarded<T: Joint>(mut world: DeferredWorld, ctx: HookContext) {
+    wake_sides::<T>(&mut world, ctx.entity);
     if let Some((a, b)) = excluded_pair::<T>(&world, ctx.entity)
         && let Some(mut excluded) = world.get_resource_mut::<crate::collision::PairExclusions>()
     {

@@ -1,6 +1,7 @@
 //! Joints against closed forms, at the defaults.
 
 mod hard_cases;
+mod kinematic_carriers;
 mod limits;
 mod motors;
 mod pendulums;
