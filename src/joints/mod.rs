@@ -131,6 +131,10 @@ fn excluded_pair<T: Joint>(world: &DeferredWorld, entity: Entity) -> Option<(Ent
 /// Wakes the bodies of the joint on `entity`: a joint put on or taken off a sleeping body
 /// changes what holds it.
 fn wake_sides<T: Joint>(world: &mut DeferredWorld, entity: Entity) {
+    // A restore writes the joints beside the sleep state it captured.
+    if world.contains_resource::<crate::core::restore::Restoring>() {
+        return;
+    }
     let Some(bodies) = world.get::<T>(entity).map(|j| *j.bodies()) else {
         return;
     };

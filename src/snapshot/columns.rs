@@ -87,6 +87,10 @@ use crate::integrator::ImplicitEuler;
 use crate::integrator::ImplicitState;
 use crate::integrator::IntegratorOverride;
 use crate::integrator::LocalSubsteps;
+use crate::joints::{
+    DistanceJoint, FixedJoint, JointBreakForce, JointImpulse, PrismaticJoint, RevoluteJoint,
+    SphericalJoint,
+};
 use crate::particles::ExternalForce;
 use crate::particles::ExternalImpulse;
 use crate::particles::Force;
@@ -140,6 +144,7 @@ validated!(
     AngularDamping,
     KinematicTarget,
     CenterOfMass,
+    JointBreakForce,
 );
 plain!(
     Force,
@@ -171,6 +176,7 @@ plain!(
     Inertia,
     SkipRenormalization,
     RigidBody,
+    JointImpulse,
 );
 
 impl Column for Mass {
@@ -228,6 +234,31 @@ impl Column for NodeAttachments {
         self.bodies_mut().collect()
     }
 }
+
+/// A joint kind: checked as on insert, its bodies mapped.
+macro_rules! jointed {
+    ($($ty:ty),* $(,)?) => {
+        $(impl Column for $ty {
+            settled!();
+
+            fn check(&self) -> Result<(), Error> {
+                Validate::validate(self)
+            }
+
+            fn entities_mut(&mut self) -> Vec<&mut Entity> {
+                self.bodies.a.iter_mut().chain([&mut self.bodies.b]).collect()
+            }
+        })*
+    };
+}
+
+jointed!(
+    SphericalJoint,
+    RevoluteJoint,
+    FixedJoint,
+    PrismaticJoint,
+    DistanceJoint
+);
 
 impl Column for Quarantined {
     // The entities a reason names are for reading only: one that is gone stays as it was.
@@ -446,6 +477,13 @@ columns!(
     soft_body: SoftBody,
     node_targets: NodeTargets,
     node_attachments: NodeAttachments,
+    spherical_joint: SphericalJoint,
+    revolute_joint: RevoluteJoint,
+    fixed_joint: FixedJoint,
+    prismatic_joint: PrismaticJoint,
+    distance_joint: DistanceJoint,
+    joint_impulse: JointImpulse,
+    joint_break_force: JointBreakForce,
     quarantined: Quarantined,
 );
 

@@ -34,7 +34,7 @@
 //! ```
 //!
 //! **What is in one.** Every hooke component of every entity that has one (bodies, springs,
-//! meshes, colliders and their parts, sleep and quarantine markers, the implicit solver's
+//! joints with their warm-start impulses, meshes, colliders and their parts, sleep and quarantine markers, the implicit solver's
 //! kept factor), the parent links of child colliders, the settings and clock resources, and
 //! the contact manifolds with their warm-start impulses, and the broad phase's kept boxes (it
 //! keeps a grown box while the collider stays inside it, so its candidate pairs depend on
@@ -85,7 +85,7 @@ use columns::Columns;
 
 /// The version [`Snapshot::to_bytes`] writes and [`Snapshot::from_bytes`] reads. It changes
 /// whenever the stored state changes shape.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 const MAGIC: [u8; 8] = *b"HOOKESNP";
 const HEADER: usize = 8 + 4 + 8 + 4;
@@ -190,6 +190,7 @@ struct Resources {
     stability_policy: Option<StabilityPolicy>,
     entity_spring_stability: Option<EntitySpringStability>,
     entity_spring_factor: Option<crate::springs::EntitySpringFactor>,
+    joint_settings: Option<crate::joints::JointSettings>,
 }
 
 macro_rules! resources {
@@ -238,6 +239,7 @@ resources!(
     stability_policy: StabilityPolicy,
     entity_spring_stability: EntitySpringStability,
     entity_spring_factor: crate::springs::EntitySpringFactor,
+    joint_settings: crate::joints::JointSettings,
 );
 
 /// The physics state of a world (see the module docs).

@@ -23,6 +23,11 @@ fn state_bits(world: &World, entities: impl Iterator<Item = Entity>) -> Vec<u32>
         if let Some(l) = r.get::<AngularMomentum>() {
             push(l.0.to_array());
         }
+        if let Some(j) = r.get::<JointImpulse>() {
+            push(j.linear.to_array());
+            push(j.angular.to_array());
+            push([j.motor, j.lower, j.upper]);
+        }
         if let Some(q) = r.get::<Rotation>() {
             out.extend(q.0.to_array().map(f32::to_bits));
         }
@@ -41,7 +46,7 @@ fn state_bits(world: &World, entities: impl Iterator<Item = Entity>) -> Vec<u32>
 /// Builds a scene, steps it 100 steps (running `meddle` at step 50), snapshots it, restores
 /// the snapshot through `format` into a fresh world, then steps both 500 more and compares
 /// after every 50.
-fn round_trip(
+pub(super) fn round_trip(
     build: impl Fn(&mut World),
     meddle: impl Fn(&mut World),
     format: impl Fn(&Snapshot) -> Snapshot,
@@ -99,11 +104,11 @@ fn round_trip(
     (originals.len(), state_bits(&world, originals.into_iter()))
 }
 
-fn via_bytes(s: &Snapshot) -> Snapshot {
+pub(super) fn via_bytes(s: &Snapshot) -> Snapshot {
     Snapshot::from_bytes(&s.to_bytes()).expect("read bytes")
 }
 
-fn via_ron(s: &Snapshot) -> Snapshot {
+pub(super) fn via_ron(s: &Snapshot) -> Snapshot {
     Snapshot::from_ron(&s.to_ron().expect("write RON")).expect("read RON")
 }
 

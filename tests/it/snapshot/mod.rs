@@ -2,3 +2,4 @@
 
 mod continue_bit_identically;
 mod determinism_goldens;
+mod joints_continue_bit_identically;
