@@ -76,6 +76,7 @@ impl WorldPlugin for SleepPlugin {
             PhysicsSchedule,
             (
                 wake_on_user_change,
+                wake_on_joint_change,
                 wake_on_structural_change,
                 update_islands,
             )
@@ -121,6 +122,35 @@ fn wake_on_user_change(
         commands.entity(e).remove::<Sleeping>();
     }
 }
+
+/// Game code changed a joint (a motor set, a limit moved): wake what it holds. (hooke never
+/// writes a joint's kind, so any change is the game's.)
+fn wake_on_joint_change(
+    mut commands: Commands,
+    changed: Query<Kinds, (Without<Quarantined>, ChangedJoint)>,
+    mut sleepers: Query<&mut SleepTimer, With<Sleeping>>,
+) {
+    for j in &changed {
+        let Some(ends) = joints::bodies(j) else {
+            continue;
+        };
+        for e in ends.a.into_iter().chain([ends.b]) {
+            if let Ok(mut timer) = sleepers.get_mut(e) {
+                timer.0 = 0.0;
+                commands.entity(e).remove::<Sleeping>();
+            }
+        }
+    }
+}
+
+/// A joint of any kind changed.
+type ChangedJoint = Or<(
+    Changed<joints::SphericalJoint>,
+    Changed<joints::RevoluteJoint>,
+    Changed<joints::FixedJoint>,
+    Changed<joints::PrismaticJoint>,
+    Changed<joints::DistanceJoint>,
+)>;
 
 /// A collider was removed, despawned, replaced or resized: every sleeping island that touched
 /// it wakes, so that a stack whose middle box or ground went falls (it floated before).

@@ -134,6 +134,10 @@ pub enum Error {
     /// The world has no physics: add the plugins first (`world.add_physics(PhysicsPlugins)`).
     #[error("the world has no physics: call add_physics(PhysicsPlugins) first")]
     NoPhysics,
+    /// A motor was set on a joint that takes none (only hinges and sliders do), or on one
+    /// that is gone.
+    #[error("{0} is not a hinge or a slider: only they take a motor")]
+    NoMotor(Entity),
     /// An error read back from a snapshot (the message of the error it was).
     #[error("{0}")]
     Restored(String),

@@ -14,17 +14,17 @@ use super::solve::{Accumulated, Axis, Mode, Rows, Side};
 /// The axis as it stands: its direction (world), whether it is linear, the lever arms its
 /// impulse acts at, and its value.
 #[derive(Debug, Clone, Copy)]
-struct Measured {
-    n: Vec3A,
-    linear: bool,
-    r_a: Vec3A,
-    r_b: Vec3A,
-    value: f32,
+pub(super) struct Measured {
+    pub n: Vec3A,
+    pub linear: bool,
+    pub r_a: Vec3A,
+    pub r_b: Vec3A,
+    pub value: f32,
 }
 
 impl Measured {
     /// The rate of change of the value.
-    fn rate(&self, a: &Side, b: &Side) -> f32 {
+    pub fn rate(&self, a: &Side, b: &Side) -> f32 {
         if self.linear {
             let va = a.v + a.w.cross(self.r_a);
             let vb = b.v + b.w.cross(self.r_b);
@@ -77,7 +77,8 @@ pub(super) fn hinge_angle(qa: Quat, qb: Quat, axis_a: Vec3, axis_b: Vec3) -> f32
     2.0 * along.atan2(twist.w)
 }
 
-fn measure(rows: &Rows, a: &Side, b: &Side) -> Option<Measured> {
+/// The free axis as it stands between `a` and `b`, when the joint has one.
+pub(super) fn measure(rows: &Rows, a: &Side, b: &Side) -> Option<Measured> {
     let r_a = a.q * rows.local_a;
     let r_b = b.q * rows.local_b;
     let d = (b.x + r_b) - (a.x + r_a);
@@ -141,14 +142,14 @@ pub(super) fn world_impulse(rows: &Rows, acc: &Accumulated, a: &Side, b: &Side) 
     }
 }
 
-/// Solves the axis's motor, then its lower and upper limits, each on its own.
+/// Solves the axis's motor, then (with `limits`; a group solve takes them otherwise) its
+/// lower and upper limits, each on its own.
 pub(super) fn solve(
     rows: &Rows,
-    a: &mut Side,
-    b: &mut Side,
+    (a, b): (&mut Side, &mut Side),
     acc: &mut Accumulated,
-    mode: Mode,
-    h: f32,
+    (mode, h): (Mode, f32),
+    limits: bool,
 ) {
     let Some(m) = measure(rows, a, b) else {
         return;
@@ -163,7 +164,7 @@ pub(super) fn solve(
         acc.motor = (held - (m.rate(a, b) - target) / k).clamp(-limit, limit);
         m.apply(a, b, acc.motor - held);
     }
-    let Some((min, max)) = rows.axial.limits else {
+    let Some((min, max)) = rows.axial.limits.filter(|_| limits) else {
         return;
     };
     for (sign, c, held) in [

@@ -19,8 +19,18 @@ use super::solve::{Accumulated, Angular, Linear, Mode, Rows, Side};
 /// rows³/3 per pass (96 rows: 0.3 M operations).
 pub(super) const MAX_GROUP_ROWS: usize = 96;
 
-/// One constraint row: its Jacobian on each side, the joint it belongs to and whether it is
-/// linear (its impulse adds to the joint's linear accumulator) or angular.
+/// What a row's impulse adds to: the joint's linear or angular accumulator (a vector, along
+/// the row's direction), or one of its limits' (a one-sided row: its total stays ≥ 0).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Held {
+    Linear,
+    Angular,
+    Lower,
+    Upper,
+}
+
+/// One constraint row: its Jacobian on each side, the joint it belongs to and what its
+/// impulse adds to.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Row {
     pub joint: usize,
@@ -32,21 +42,26 @@ pub(super) struct Row {
     pub ang_b: Vec3A,
     /// The row's direction (world frame): its impulse is this times λ.
     pub dir: Vec3A,
-    pub linear: bool,
+    pub held: Held,
     /// Position error (m or rad).
     pub c: f32,
+    /// A limit short of its stop: the rate that closes the gap within the substep, C / h
+    /// (rigid in every pass, Box2D's speculative row).
+    pub speculative: Option<f32>,
     /// The row's speed from its immovable sides (m/s or rad/s): a kinematic body moves the
     /// anchor it holds, and the rows must follow it.
     pub carried: f32,
 }
 
 /// The rows of one joint between sides `a` and `b` (indices into the pass's bodies; `None`
-/// for an immovable side).
+/// for an immovable side), with its limits' rows when `limits` holds the substep length
+/// and its accumulated limit impulses (lower, upper).
 pub(super) fn joint_rows(
     joint: usize,
     rows: &Rows,
     (ia, a): (Option<usize>, &Side),
     (ib, b): (Option<usize>, &Side),
+    limits: Option<(f32, f32, f32)>,
     out: &mut Vec<Row>,
 ) {
     let base = Row {
@@ -58,8 +73,9 @@ pub(super) fn joint_rows(
         lin_b: Vec3A::ZERO,
         ang_b: Vec3A::ZERO,
         dir: Vec3A::ZERO,
-        linear: false,
+        held: Held::Angular,
         c: 0.0,
+        speculative: None,
         carried: 0.0,
     };
     let start = out.len();
@@ -103,7 +119,7 @@ pub(super) fn joint_rows(
             lin_b: e,
             ang_b: r_b.cross(e),
             dir: e,
-            linear: true,
+            held: Held::Linear,
             c: e.dot(gap),
             ..base
         });
@@ -116,6 +132,42 @@ pub(super) fn joint_rows(
             linear(v.into());
         }
         Linear::Free => {}
+    }
+    if let (Some((h, lower, upper)), Some((min, max))) = (limits, rows.axial.limits)
+        && let Some(m) = super::axial::measure(rows, a, b)
+    {
+        // The nearer stop only (or the one pushing): the two cannot both hold.
+        let near_lower = if lower > 0.0 || upper > 0.0 {
+            lower >= upper
+        } else {
+            m.value - min <= max - m.value
+        };
+        let (held, sign, c, acc) = if near_lower {
+            (Held::Lower, 1.0, m.value - min, lower)
+        } else {
+            (Held::Upper, -1.0, max - m.value, upper)
+        };
+        let n = sign * m.n;
+        // Far from its stop and not pushing: it cannot reach the stop in this substep.
+        let closing = -sign * m.rate(a, b);
+        if acc > 0.0 || c <= 2.0 * h * closing.max(0.0) {
+            let (lin_a, ang_a, lin_b, ang_b) = if m.linear {
+                (-n, -m.r_a.cross(n), n, m.r_b.cross(n))
+            } else {
+                (Vec3A::ZERO, -n, Vec3A::ZERO, n)
+            };
+            out.push(Row {
+                lin_a,
+                ang_a,
+                lin_b,
+                ang_b,
+                dir: n,
+                held,
+                c,
+                speculative: (c > 0.0).then(|| c / h),
+                ..base
+            });
+        }
     }
     for row in &mut out[start..] {
         if ia.is_none() {
@@ -142,11 +194,87 @@ pub(super) fn solve(
     mode: Mode,
     scratch: &mut Vec<f64>,
 ) {
-    let n = rows.len();
-    if n == 0 {
-        return;
+    if rows
+        .iter()
+        .any(|r| matches!(r.held, Held::Lower | Held::Upper))
+    {
+        solve_with_limits(rows, bodies, acc, mode, scratch);
+    } else {
+        solve_equalities(rows, bodies, acc, mode, scratch);
     }
+}
+
+/// The limits' rows are one-sided: solved with the rest as equalities, any whose total
+/// impulse would pull is let go (its held impulse taken back) and the rest solved again, so
+/// a hinge stopped at its limit stops about the hinge, not about its centre of mass.
+fn solve_with_limits(
+    rows: &[Row],
+    bodies: &mut [Side],
+    acc: &mut [Accumulated],
+    mode: Mode,
+    scratch: &mut Vec<f64>,
+) {
+    let mut live = rows.to_vec();
+    // Each round lets go of at least one row, so this ends.
+    loop {
+        if !solve_system(&live, bodies, mode, scratch) {
+            return;
+        }
+        let n = live.len();
+        let x = &scratch[n * n..];
+        let mut let_go = false;
+        let mut k = 0;
+        live.retain(|rp| {
+            let i = k;
+            k += 1;
+            let one_sided = matches!(rp.held, Held::Lower | Held::Upper);
+            if one_sided && held(rp, acc) + lambda(rp, x[i], acc, mode) < 0.0 {
+                let_go = true;
+                false
+            } else {
+                true
+            }
+        });
+        if !let_go {
+            apply(&live, x, bodies, acc, mode);
+            return;
+        }
+        for rp in rows {
+            let one_sided = matches!(rp.held, Held::Lower | Held::Upper);
+            let gone = !live
+                .iter()
+                .any(|l| l.joint == rp.joint && l.held == rp.held);
+            let h = held(rp, acc);
+            if one_sided && gone && h != 0.0 {
+                push(rp, -h, bodies, acc);
+            }
+        }
+    }
+}
+
+/// Solves `rows` as equalities and applies the impulses.
+fn solve_equalities(
+    rows: &[Row],
+    bodies: &mut [Side],
+    acc: &mut [Accumulated],
+    mode: Mode,
+    scratch: &mut Vec<f64>,
+) {
+    if solve_system(rows, bodies, mode, scratch) {
+        let n = rows.len();
+        apply(rows, &scratch[n * n..], bodies, acc, mode);
+    }
+}
+
+/// Builds A (the coupled effective mass) and b in `scratch` and solves A x = b: x is then
+/// `scratch[n²..]`. False when there is nothing to solve or A has no usable pivot (x is
+/// then zero).
+fn solve_system(rows: &[Row], bodies: &[Side], mode: Mode, scratch: &mut Vec<f64>) -> bool {
+    let n = rows.len();
     scratch.clear();
+    if n == 0 {
+        return false;
+    }
     scratch.resize(n * n + n, 0.0);
     let (a, rhs) = scratch.split_at_mut(n * n);
     let sides = |r: &Row| [(r.a, r.lin_a, r.ang_a), (r.b, r.lin_b, r.ang_b)];
@@ -168,10 +296,11 @@ pub(super) fn solve(
         }
         rhs[p] = target(rp, bodies, mode);
     }
-    if !cholesky_solve(a, rhs, n) {
-        return;
+    if cholesky_solve(a, rhs, n) {
+        return true;
     }
-    apply(rows, rhs, bodies, acc, mode);
+    rhs.fill(0.0);
+    false
 }
 
 /// The right-hand side of row `rp`: −S_m (Ċ + β C).
@@ -180,7 +309,53 @@ pub(super) fn target(rp: &Row, bodies: &[Side], mode: Mode) -> f64 {
         body.map_or(0.0, |s| lin.dot(bodies[s].v) + ang.dot(bodies[s].w))
     };
     let cdot = speed(rp.a, rp.lin_a, rp.ang_a) + speed(rp.b, rp.lin_b, rp.ang_b) + rp.carried;
-    f64::from(-mode.mass_scale * (cdot + mode.bias_rate * rp.c))
+    f64::from(match rp.speculative {
+        Some(bias) => -(cdot + bias),
+        None => -mode.mass_scale * (cdot + mode.bias_rate * rp.c),
+    })
+}
+
+/// The impulse row `rp` holds from before this solve (its share of the joint's
+/// accumulator).
+fn held(rp: &Row, acc: &[Accumulated]) -> f32 {
+    let acc = &acc[rp.joint];
+    match rp.held {
+        Held::Linear => rp.dir.dot(acc.linear),
+        Held::Angular => rp.dir.dot(acc.angular),
+        Held::Lower => acc.lower,
+        Held::Upper => acc.upper,
+    }
+}
+
+/// The new impulse λ of row `rp` for the solution `x`: x − S_i held (a speculative row
+/// keeps nothing of what it held).
+fn lambda(rp: &Row, x: f64, acc: &[Accumulated], mode: Mode) -> f32 {
+    let scale = if rp.speculative.is_some() {
+        0.0
+    } else {
+        mode.impulse_scale
+    };
+    x as f32 - scale * held(rp, acc)
+}
+
+/// Applies `lambda` along row `rp` to its bodies and adds it to the joint's accumulator.
+fn push(rp: &Row, lambda: f32, bodies: &mut [Side], acc: &mut [Accumulated]) {
+    for (body, lin, ang) in [(rp.a, rp.lin_a, rp.ang_a), (rp.b, rp.lin_b, rp.ang_b)] {
+        if let Some(s) = body {
+            let side = &mut bodies[s];
+            let (dv, dw) = response(side, lin, ang);
+            side.v += lambda * dv;
+            side.w += lambda * dw;
+            side.dl += lambda * ang;
+        }
+    }
+    let acc = &mut acc[rp.joint];
+    match rp.held {
+        Held::Linear => acc.linear += lambda * rp.dir,
+        Held::Angular => acc.angular += lambda * rp.dir,
+        Held::Lower => acc.lower += lambda,
+        Held::Upper => acc.upper += lambda,
+    }
 }
 
 /// Applies the solution `x` of A x = b to the rows' bodies: λ = x − S_i (the row's share of
@@ -192,32 +367,11 @@ pub(super) fn apply(
     acc: &mut [Accumulated],
     mode: Mode,
 ) {
-    let sides = |r: &Row| [(r.a, r.lin_a, r.ang_a), (r.b, r.lin_b, r.ang_b)];
     for (rp, &x) in rows.iter().zip(x.iter()) {
-        let held = if rp.linear {
-            acc[rp.joint].linear
-        } else {
-            acc[rp.joint].angular
-        };
-        let lambda = x as f32 - mode.impulse_scale * rp.dir.dot(held);
-        if !lambda.is_finite() {
-            continue;
+        let lambda = lambda(rp, x, acc, mode);
+        if lambda.is_finite() {
+            push(rp, lambda, bodies, acc);
         }
-        for (body, lin, ang) in sides(rp) {
-            if let Some(s) = body {
-                let side = &mut bodies[s];
-                let (dv, dw) = response(side, lin, ang);
-                side.v += lambda * dv;
-                side.w += lambda * dw;
-                side.dl += lambda * ang;
-            }
-        }
-        let held = if rp.linear {
-            &mut acc[rp.joint].linear
-        } else {
-            &mut acc[rp.joint].angular
-        };
-        *held += lambda * rp.dir;
     }
 }
 
@@ -315,6 +469,7 @@ mod tests {
                 &geometry,
                 (Some(a), &sides[a]),
                 (Some(b), &sides[b]),
+                None,
                 &mut rows,
             );
         }
@@ -350,6 +505,7 @@ mod tests {
             &geometry,
             (Some(0), &sides[0]),
             (Some(1), &sides[1]),
+            None,
             &mut rows,
         );
         let (mut dense, mut acc_dense) = (sides.clone(), vec![start]);
@@ -380,6 +536,7 @@ mod tests {
             &geometry,
             (None, &sides[0]),
             (Some(1), &sides[1]),
+            None,
             &mut rows,
         );
         let mut acc = vec![Accumulated::default()];

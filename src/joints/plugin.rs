@@ -211,6 +211,8 @@ struct Scratch {
     /// Per joint: its geometry and its sides' places in `sides`.
     joints: Vec<(Rows, usize, usize)>,
     acc: Vec<Accumulated>,
+    /// Per joint: whether its group is solved as one system (and takes its limits).
+    in_block: Vec<bool>,
     /// Union–find over `sides`: the groups of bodies joints connect.
     parent: Vec<usize>,
     /// Per joint, its group's root; then the joints in group order.
@@ -304,9 +306,6 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
             }
         }
     }
-    // Motors and limits first, each on its own (Box2D's order): the rows after them keep
-    // what they leave free, the free axis.
-    free_axes(s, mode, h);
     // Groups: bodies joined through moving bodies (an immovable side joins nothing).
     s.parent.clear();
     s.parent.extend(0..s.sides.len());
@@ -333,19 +332,39 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     }
     // Keys are unique (a joint is in one group), so an unstable sort orders them fully.
     s.order.sort_unstable();
+    // A group solved as one system takes its joints' limits with its other rows (a door
+    // stopped at its limit stops about its hinge); elsewhere they are solved on their own.
+    s.in_block.clear();
+    s.in_block.resize(s.joints.len(), false);
     let mut k = 0;
     while k < s.order.len() {
-        let group = s.order[k].0;
-        let end = k + s.order[k..].iter().take_while(|o| o.0 == group).count();
-        let count: usize = s.order[k..end]
-            .iter()
-            .map(|&(_, j)| s.joints[j].0.count())
-            .sum();
+        let end = group_end(s, k);
+        if group_rows(s, k, end) <= block::MAX_GROUP_ROWS {
+            for i in k..end {
+                let j = s.order[i].1;
+                // A rod (min = max) keeps its two-sided pair of rows apart: as rows of one
+                // system they would be one row twice.
+                s.in_block[j] = s.joints[j]
+                    .0
+                    .axial
+                    .limits
+                    .is_none_or(|(min, max)| min < max);
+            }
+        }
+        k = end;
+    }
+    // Motors (and the limits no group takes) first, each on its own (Box2D's order): the
+    // rows after them keep what they leave free, the free axis.
+    free_axes(s, mode, h);
+    let mut k = 0;
+    while k < s.order.len() {
+        let end = group_end(s, k);
+        let count = group_rows(s, k, end);
         if count <= block::MAX_GROUP_ROWS || mostly_tree(s, k, end) {
             s.rows.clear();
             for i in k..end {
                 let j = s.order[i].1;
-                push_rows(s, j);
+                push_rows(s, j, h);
             }
             if count <= block::MAX_GROUP_ROWS {
                 block::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.matrix);
@@ -367,7 +386,7 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
                     continue;
                 }
                 s.rows.clear();
-                push_rows(s, j);
+                push_rows(s, j, h);
                 block::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.matrix);
             }
         }
@@ -419,15 +438,31 @@ fn stiffen_sides(s: &mut Scratch, joints: &Joints, h: f32) {
     }
 }
 
-/// Solves every free axis's motor and limits, each joint on its own.
+/// Solves every free axis's motor, and its limits unless its group takes them, each joint
+/// on its own.
 fn free_axes(s: &mut Scratch, mode: Mode, h: f32) {
     for (j, &(rows, ia, ib)) in s.joints.iter().enumerate() {
         if rows.axial.active()
-            && let Ok([a, b]) = s.sides.get_disjoint_mut([ia, ib])
+            && let Ok(sides) = s.sides.get_disjoint_mut([ia, ib])
         {
-            axial::solve(&rows, a, b, &mut s.acc[j], mode, h);
+            let [a, b] = sides;
+            axial::solve(&rows, (a, b), &mut s.acc[j], (mode, h), !s.in_block[j]);
         }
     }
+}
+
+/// The end of the group that starts at `s.order[k]`.
+fn group_end(s: &Scratch, k: usize) -> usize {
+    let group = s.order[k].0;
+    k + s.order[k..].iter().take_while(|o| o.0 == group).count()
+}
+
+/// The locked rows of the group `s.order[k..end]`.
+fn group_rows(s: &Scratch, k: usize, end: usize) -> usize {
+    s.order[k..end]
+        .iter()
+        .map(|&(_, j)| s.joints[j].0.count())
+        .sum()
 }
 
 /// Whether the group of joints `s.order[k..end]` is a tree but for a few loops: fewer than
@@ -452,15 +487,18 @@ fn mostly_tree(s: &mut Scratch, k: usize, end: usize) -> bool {
     loops * 10 < end - k
 }
 
-/// Appends joint `j`'s rows to `s.rows`, each side named only if it moves.
-fn push_rows(s: &mut Scratch, j: usize) {
+/// Appends joint `j`'s rows to `s.rows`, each side named only if it moves; its limits'
+/// rows too when its group is solved as one system.
+fn push_rows(s: &mut Scratch, j: usize, h: f32) {
     let (rows, ia, ib) = s.joints[j];
     let moving = |i: usize| s.sides[i].moves.then_some(i);
+    let limits = s.in_block[j].then(|| (h, s.acc[j].lower, s.acc[j].upper));
     block::joint_rows(
         j,
         &rows,
         (moving(ia), &s.sides[ia]),
         (moving(ib), &s.sides[ib]),
+        limits,
         &mut s.rows,
     );
 }

@@ -526,7 +526,7 @@ mod tests {
         };
         for (j, (a, b, geometry)) in joints.iter().take(count).enumerate() {
             let side = |i: usize| ((i > 0).then_some(i), &sides[i]);
-            block::joint_rows(j, geometry, side(*a), side(*b), &mut rows);
+            block::joint_rows(j, geometry, side(*a), side(*b), None, &mut rows);
         }
         (sides, rows)
     }

@@ -61,6 +61,8 @@ pub enum PluginName {
     Collision,
     /// [`crate::sleep::SleepPlugin`].
     Sleep,
+    /// [`crate::joints::JointPlugin`].
+    Joints,
     /// [`crate::soft::SoftBodyPlugin`].
     SoftBody,
     /// [`crate::cloth::ClothPlugin`].
@@ -165,6 +167,28 @@ pub enum Spawn {
         #[serde(default)]
         anchor_b: Vec3,
     },
+    /// A joint between two named bodies, or a body and the world (`a` left out).
+    Joint {
+        /// What it holds and leaves free.
+        kind: JointKind,
+        /// One body (a name or `name[i]`); left out, the world.
+        #[serde(default)]
+        a: Option<String>,
+        /// The other body.
+        b: String,
+        /// Where it holds `a` (m, in `a`'s shape axes; a world point when `a` is left out).
+        #[serde(default)]
+        anchor_a: Vec3,
+        /// Where it holds `b` (m, in `b`'s shape axes).
+        #[serde(default)]
+        anchor_b: Vec3,
+        /// Let the two bodies collide with each other (by default they do not).
+        #[serde(default)]
+        collide: bool,
+        /// Breaks once its force passes this (N).
+        #[serde(default)]
+        break_force: Option<f32>,
+    },
     /// A rope (or hair, `hair: true`) of particles and springs, pinned at its start.
     Rope {
         /// First node (m).
@@ -234,6 +258,48 @@ pub enum Spawn {
         /// Rows.
         layers: usize,
     },
+}
+
+/// A joint's kind. Axes are unit vectors in each body's axes (world axes for the world side).
+#[derive(Deserialize, Debug, Clone, Copy, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub enum JointKind {
+    /// Holds the anchors together; every turn free.
+    Ball,
+    /// A hinge about `axis`.
+    Hinge {
+        /// The hinge axis.
+        axis: Vec3,
+        /// The angle's range (degrees, within ±180).
+        #[serde(default)]
+        limits: Option<(f32, f32)>,
+        /// A motor: target speed (rad/s) and the most torque it gives (N·m).
+        #[serde(default)]
+        motor: Option<(f32, f32)>,
+    },
+    /// A slider along `axis`, the relative rotation held as spawned.
+    Slider {
+        /// The slide axis.
+        axis: Vec3,
+        /// The offset's range (m).
+        #[serde(default)]
+        limits: Option<(f32, f32)>,
+        /// A motor: target speed (m/s) and the most force it gives (N).
+        #[serde(default)]
+        motor: Option<(f32, f32)>,
+    },
+    /// Keeps the anchors `length` apart (default: as spawned); `rope: true` lets them come
+    /// closer.
+    Distance {
+        /// The length (m).
+        #[serde(default)]
+        length: Option<f32>,
+        /// Slack below the length.
+        #[serde(default)]
+        rope: bool,
+    },
+    /// A weld at the relative pose as spawned.
+    Fixed,
 }
 
 fn one() -> f32 {
@@ -329,6 +395,16 @@ pub enum Action {
         entity: String,
         /// The torque (N·m).
         torque: Vec3,
+    },
+    /// Sets a hinge's or a slider's motor: target speed (rad/s or m/s) and the most torque
+    /// or force it gives (N·m or N); a zero maximum switches it off.
+    SetMotor {
+        /// The joint.
+        joint: String,
+        /// Target speed (rad/s for a hinge, m/s for a slider).
+        target_velocity: f32,
+        /// The most torque (N·m) or force (N) it gives.
+        max: f32,
     },
     /// Sets the velocity (m/s).
     SetVelocity {

@@ -12,7 +12,7 @@ use serde::Deserialize;
 
 use super::expr::Expr;
 use super::format::{
-    Action, Check, EntityEntry, ExpectEntry, PluginName, Settings, Spawn, TimelineEntry,
+    Action, Check, EntityEntry, ExpectEntry, JointKind, PluginName, Settings, Spawn, TimelineEntry,
 };
 use super::{Expectation, Scenario, ScenarioError, ScenarioErrorKind, Selector, Timed, Window};
 
@@ -118,6 +118,8 @@ struct Life {
     died: Option<u64>,
     line: usize,
     moves: bool,
+    /// A hinge or a slider: it takes a motor.
+    motor: bool,
 }
 
 pub(super) fn load(src: &str, file: &str) -> Result<Scenario, ScenarioError> {
@@ -193,10 +195,7 @@ pub(super) fn load(src: &str, file: &str) -> Result<Scenario, ScenarioError> {
     for raw_entity in &raw.entities {
         let (entry, line) = r.parse::<EntityEntry>(raw_entity)?;
         check_name(&r, &lives, &entry.name, line)?;
-        if let Spawn::Spring { a, b, .. } = &entry.spawn {
-            spring_end(&r, &lives, a, line, 0)?;
-            spring_end(&r, &lives, b, line, 0)?;
-        }
+        ends(&r, &lives, &entry.spawn, line, 0)?;
         lives.insert(entry.name.clone(), life(&entry.spawn, 0, line));
         entities.push(Timed {
             step: 0,
@@ -455,9 +454,40 @@ fn life(spawn: &Spawn, born: u64, line: usize) -> Life {
         line,
         moves: !matches!(
             spawn,
-            Spawn::Ground | Spawn::Field(_) | Spawn::Spring { .. }
+            Spawn::Ground | Spawn::Field(_) | Spawn::Spring { .. } | Spawn::Joint { .. }
+        ),
+        motor: matches!(
+            spawn,
+            Spawn::Joint {
+                kind: JointKind::Hinge { .. } | JointKind::Slider { .. },
+                ..
+            }
         ),
     }
+}
+
+/// Checks that the ends a spring or a joint names are one live entity each.
+fn ends(
+    r: &Reader,
+    lives: &HashMap<String, Life>,
+    spawn: &Spawn,
+    line: usize,
+    step: u64,
+) -> Result<(), ScenarioError> {
+    match spawn {
+        Spawn::Spring { a, b, .. } => {
+            spring_end(r, lives, a, line, step)?;
+            spring_end(r, lives, b, line, step)?;
+        }
+        Spawn::Joint { a, b, .. } => {
+            if let Some(a) = a {
+                spring_end(r, lives, a, line, step)?;
+            }
+            spring_end(r, lives, b, line, step)?;
+        }
+        _ => {}
+    }
+    Ok(())
 }
 
 fn check_name(
@@ -570,7 +600,7 @@ fn spring_end(
             line,
             1,
             ScenarioErrorKind::BadValue(format!(
-                "a spring joins two entities; \"{text}\" is a group (write {text}[i])"
+                "a spring or a joint joins two entities; \"{text}\" is a group (write {text}[i])"
             )),
         ));
     }
@@ -600,12 +630,15 @@ fn check_action(
             let despawning = matches!(a.item, Action::Despawn { .. });
             selector_at(r, lives, entity, a.line, (s, s), despawning)?;
         }
-        Action::Spawn {
-            spawn: Spawn::Spring { a: ea, b: eb, .. },
-            ..
-        } => {
-            spring_end(r, lives, ea, a.line, s)?;
-            spring_end(r, lives, eb, a.line, s)?;
+        Action::Spawn { spawn, .. } => ends(r, lives, spawn, a.line, s)?,
+        Action::SetMotor { joint, .. } => {
+            selector_at(r, lives, joint, a.line, (s, s), false)?;
+            let name = joint.split('[').next().unwrap_or(joint);
+            if !lives.get(name).is_some_and(|l| l.motor) {
+                return Err(bad(format!(
+                    "\"{joint}\" is not a hinge or a slider: only they take a motor"
+                )));
+            }
         }
         Action::Enable(p) | Action::Disable(p) => {
             if !matches!(p, PluginName::Gravity | PluginName::Sleep) {
@@ -614,7 +647,7 @@ fn check_action(
                 )));
             }
         }
-        Action::Spawn { .. } | Action::SetGravity { .. } => {}
+        Action::SetGravity { .. } => {}
     }
     Ok(())
 }

@@ -50,6 +50,7 @@ fn add_plugin(world: &mut World, p: PluginName) {
         PluginName::RigidBody => world.add_physics(crate::rigid::RigidBodyPlugin),
         PluginName::Collision => world.add_physics(crate::collision::CollisionPlugin),
         PluginName::Sleep => world.add_physics(crate::sleep::SleepPlugin),
+        PluginName::Joints => world.add_physics(crate::joints::JointPlugin),
         PluginName::SoftBody => world.add_physics(crate::soft::SoftBodyPlugin),
         PluginName::Cloth => world.add_physics(crate::cloth::ClothPlugin),
     };
@@ -299,6 +300,15 @@ fn act(
             let tau = ExternalTorque::from(finite_vec("torque", *torque)?);
             for e in group(names, entity) {
                 world.entity_mut(e).insert(tau);
+            }
+        }
+        Action::SetMotor {
+            joint,
+            target_velocity,
+            max,
+        } => {
+            for e in group(names, joint) {
+                spawn::set_motor(world, e, *target_velocity, *max)?;
             }
         }
         Action::SetVelocity { entity, velocity } => {

@@ -2,9 +2,9 @@
 //! way game code spawns them.
 
 use bevy_ecs::prelude::*;
-use glam::{EulerRot, Quat};
+use glam::{EulerRot, Quat, Vec3};
 
-use super::format::{BodyKind, Field, Shape, Spawn};
+use super::format::{BodyKind, Field, JointKind, Shape, Spawn};
 use crate::cloth::ClothBuilder;
 use crate::collision::Collider;
 use crate::collision::ColliderDensity;
@@ -13,6 +13,9 @@ use crate::collision::Restitution;
 use crate::collision::RestitutionThreshold;
 use crate::core::error::{Error, Result, finite, finite_vec, non_negative};
 use crate::core::quarantine::Validate;
+use crate::joints::{
+    DistanceJoint, FixedJoint, JointBreakForce, PrismaticJoint, RevoluteJoint, SphericalJoint,
+};
 use crate::particles::LinearDamping;
 use crate::particles::LinearVelocity;
 use crate::particles::Mass;
@@ -147,6 +150,34 @@ pub(super) fn spawn(
                 .with_anchors(*anchor_a, *anchor_b)?;
             vec![world.spawn(spring).id()]
         }
+        Spawn::Joint {
+            kind,
+            a,
+            b,
+            anchor_a,
+            anchor_b,
+            collide,
+            break_force,
+        } => {
+            // The loader checked the names are one live entity each.
+            let end = |name: &String| lookup(name).ok_or(Error::MissingEntity(Entity::PLACEHOLDER));
+            let ea = a.as_ref().map(end).transpose()?;
+            let eb = end(b)?;
+            let sides = Sides {
+                a: ea,
+                b: eb,
+                anchor_a: *anchor_a,
+                anchor_b: *anchor_b,
+                collide: *collide,
+            };
+            let mut e = joint(world, kind, &sides)?;
+            if let Some(f) = break_force {
+                let f = JointBreakForce::new(*f);
+                f.validate()?;
+                e.insert(f);
+            }
+            vec![e.id()]
+        }
         Spawn::Rope {
             from,
             to,
@@ -217,4 +248,122 @@ fn checked<T: Validate>(value: T) -> Result<T> {
 /// A friction coefficient or restitution typed in an action, checked.
 pub(super) fn material(what: &'static str, value: f32) -> Result<f32> {
     non_negative(what, finite(what, value)?)
+}
+
+/// A joint entry's two sides and anchors.
+struct Sides {
+    a: Option<Entity>,
+    b: Entity,
+    anchor_a: Vec3,
+    anchor_b: Vec3,
+    collide: bool,
+}
+
+/// Spawns the joint of `kind` between `sides`, checked first: a bad axis or limit is the
+/// file's error, not a quarantined joint.
+fn joint<'w>(world: &'w mut World, kind: &JointKind, sides: &Sides) -> Result<EntityWorldMut<'w>> {
+    let &Sides { a, b, .. } = sides;
+    let pose = |world: &World, e: Option<Entity>| {
+        e.map_or((Vec3::ZERO, Quat::IDENTITY), |e| {
+            let x = world.get::<Position>(e).map_or(Vec3::ZERO, Position::get);
+            let q = world.get::<Rotation>(e).map_or(Quat::IDENTITY, |q| q.0);
+            (x, q)
+        })
+    };
+    let ((xa, qa), (xb, qb)) = (pose(world, a), pose(world, Some(b)));
+    let relative = qa.inverse() * qb;
+    fn place<J: Component + Validate>(world: &mut World, joint: J) -> Result<EntityWorldMut<'_>> {
+        joint.validate()?;
+        Ok(world.spawn(joint))
+    }
+    macro_rules! placed {
+        ($joint:expr) => {
+            place(
+                world,
+                $joint
+                    .with_anchors(sides.anchor_a, sides.anchor_b)
+                    .with_collision(sides.collide),
+            )
+        };
+    }
+    match *kind {
+        JointKind::Ball => placed!(match a {
+            Some(a) => SphericalJoint::new(a, b),
+            None => SphericalJoint::to_world(b),
+        }),
+        JointKind::Hinge {
+            axis,
+            limits,
+            motor,
+        } => {
+            let mut j = match a {
+                Some(a) => RevoluteJoint::new(a, b, axis),
+                None => RevoluteJoint::to_world(b, axis),
+            };
+            if let Some((min, max)) = limits {
+                j = j.with_limits(min.to_radians(), max.to_radians());
+            }
+            if let Some((speed, torque)) = motor {
+                j = j.with_motor(speed, torque);
+            }
+            placed!(j)
+        }
+        JointKind::Slider {
+            axis,
+            limits,
+            motor,
+        } => {
+            let mut j = match a {
+                Some(a) => PrismaticJoint::new(a, b, axis).with_relative(relative),
+                None => PrismaticJoint::to_world(b, axis).with_relative(qb),
+            };
+            if let Some((min, max)) = limits {
+                j = j.with_limits(min, max);
+            }
+            if let Some((speed, force)) = motor {
+                j = j.with_motor(speed, force);
+            }
+            placed!(j)
+        }
+        JointKind::Distance { length, rope } => {
+            let at = |x: Vec3, q: Quat, local: Vec3, world_side: bool| {
+                if world_side { local } else { x + q * local }
+            };
+            let spawned =
+                at(xa, qa, sides.anchor_a, a.is_none()).distance(at(xb, qb, sides.anchor_b, false));
+            let l = length.unwrap_or(spawned);
+            let mut j = match a {
+                Some(a) => DistanceJoint::new(a, b, l),
+                None => DistanceJoint::to_world(b, l),
+            };
+            if rope {
+                j = j.with_limits(0.0, l);
+            }
+            placed!(j)
+        }
+        JointKind::Fixed => placed!(match a {
+            Some(a) => FixedJoint::new(a, b, relative),
+            None => FixedJoint::to_world(b, qb),
+        }),
+    }
+}
+
+/// Sets the motor of the hinge or slider `e`.
+pub(super) fn set_motor(
+    world: &mut World,
+    e: Entity,
+    target_velocity: f32,
+    max: f32,
+) -> Result<()> {
+    finite("motor target velocity", target_velocity)?;
+    non_negative("motor maximum", max)?;
+    if let Some(mut j) = world.get_mut::<RevoluteJoint>(e) {
+        *j = j.with_motor(target_velocity, max);
+    } else if let Some(mut j) = world.get_mut::<PrismaticJoint>(e) {
+        *j = j.with_motor(target_velocity, max);
+    } else {
+        // The loader checked it was spawned a hinge or a slider: it broke or was taken off.
+        return Err(Error::NoMotor(e));
+    }
+    Ok(())
 }

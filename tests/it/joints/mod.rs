@@ -5,6 +5,7 @@ mod kinematic_carriers;
 mod limits;
 mod motors;
 mod pendulums;
+mod stops;
 
 /// Why the entity `e` is quarantined: its input error as text.
 fn quarantine_reason(world: &bevy_ecs::world::World, e: bevy_ecs::entity::Entity) -> String {

@@ -168,3 +168,27 @@ fn scenario_errors_carry_hooke_errors_and_both_pass_through_question_marks() {
         "{bad}"
     );
 }
+
+#[test]
+fn a_motor_on_a_joint_that_takes_none_is_refused_with_its_line() {
+    let e = error("motor_on_ball_joint.ron");
+    assert!(
+        matches!(&e.kind, ScenarioErrorKind::BadValue(m) if m.contains("not a hinge or a slider")),
+        "{e}"
+    );
+    assert_eq!(e.line, 9);
+}
+
+#[test]
+fn a_joint_with_a_bad_axis_is_a_build_error_with_its_line() {
+    let s = load("bad_joint_axis.ron").expect("the file itself is well formed");
+    let e = s.run().expect_err("a zero axis");
+    assert!(
+        matches!(
+            e.kind,
+            ScenarioErrorKind::Build(hooke::Error::OutOfRange { .. })
+        ),
+        "{e}"
+    );
+    assert_eq!(e.line, 6);
+}
