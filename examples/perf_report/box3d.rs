@@ -7,6 +7,7 @@ use hooke::prelude::*;
 use hooke::tools::box3d::{self, Scene};
 
 use crate::rapier_box3d::rapier_scene;
+use crate::rapier_joints::widest_gap;
 use crate::timing::{line, mean_step_time, median};
 
 /// What the scene looks like after its steps: the highest body's height (m) in each engine.
@@ -29,16 +30,7 @@ fn scene_line(scene: Scene, small: bool, runs: usize, steps: usize) {
             .iter()
             .map(|&h| r.bodies[h].translation().y)
             .fold(f32::NEG_INFINITY, f32::max);
-        gap_b = r
-            .impulse_joints
-            .iter()
-            .map(|(_, j)| {
-                let (b1, b2) = (&r.bodies[j.body1()], &r.bodies[j.body2()]);
-                let a1 = b1.position() * j.data.local_frame1.translation;
-                let a2 = b2.position() * j.data.local_frame2.translation;
-                (a1 - a2).length()
-            })
-            .fold(0.0, f32::max);
+        gap_b = widest_gap(&r);
     }
     let gaps = if gap_a > 0.0 || gap_b > 0.0 {
         format!(

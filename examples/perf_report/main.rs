@@ -14,10 +14,13 @@
 mod bevy_layer;
 mod box3d;
 mod contacts;
+mod joints;
 #[path = "../common/rapier_box3d.rs"]
 mod rapier_box3d;
 #[path = "../common/rapier_boxes.rs"]
 mod rapier_boxes;
+#[path = "../common/rapier_joints.rs"]
+mod rapier_joints;
 mod rigid;
 mod scaling;
 mod scenario;
@@ -389,7 +392,7 @@ fn main() {
         "{:<48} {:>14} {:>14} {:>7}  note",
         "name", "ours_ns", "reference_ns", "ratio"
     );
-    // `--only particles|rigid|contacts|box3d|scaling|springs|scenario|snapshot|soft|bevy|dial` runs one group (bevy with `--features bevy`).
+    // `--only particles|rigid|contacts|box3d|joints|scaling|springs|scenario|snapshot|soft|bevy|dial` runs one group (bevy with `--features bevy`).
     let only = std::env::args()
         .skip_while(|a| a != "--only")
         .nth(1)
@@ -411,6 +414,9 @@ fn main() {
     }
     if run("box3d") {
         box3d::box3d_suite(quick);
+    }
+    if run("joints") {
+        joints::chain_vs_rapier(if quick { 3 } else { 5 }, if quick { 60 } else { 300 });
     }
     if run("scaling") {
         scaling::scaling_lines(&cfg, quick);
