@@ -213,6 +213,7 @@ pub mod prelude {
     pub use crate::joints::JointImpulse;
     pub use crate::joints::JointLimits;
     pub use crate::joints::LinearMotor;
+    pub use crate::joints::MotorSpring;
     pub use crate::joints::PrismaticJoint;
     pub use crate::joints::RevoluteJoint;
     pub use crate::joints::SphericalJoint;

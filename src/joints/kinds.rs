@@ -112,24 +112,73 @@ impl JointLimits {
 }
 
 /// A motor on a hinge: it drives the turn of `b` relative to `a` about the hinge axis (axis
-/// direction, right-handed) towards `target_velocity`, with at most `max_torque`. Solved in
-/// every pass before the joint's other rows, as Box2D solves its motors.
+/// direction, right-handed) towards `target_velocity`, with at most `max_torque`; with a
+/// [`MotorSpring`], as a spring–damper towards an angle. Solved in every pass before the
+/// joint's other rows, as Box2D solves its motors.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
 pub struct AngularMotor {
     /// The relative angular velocity it drives towards (rad/s).
     pub target_velocity: f32,
     /// The largest torque it exerts (N·m, ≥ 0).
     pub max_torque: f32,
+    /// A spring towards an angle (rad, within [−π, π]; N·m/rad, N·m·s/rad); without one the
+    /// motor holds its target velocity rigidly.
+    #[serde(default)]
+    pub spring: Option<MotorSpring>,
 }
 
 /// A motor on a slider: it drives `b`'s slide relative to `a` along the axis towards
-/// `target_velocity`, with at most `max_force`.
+/// `target_velocity`, with at most `max_force`; with a [`MotorSpring`], as a spring–damper
+/// towards an offset.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
 pub struct LinearMotor {
     /// The relative velocity along the axis it drives towards (m/s).
     pub target_velocity: f32,
     /// The largest force it exerts (N, ≥ 0).
     pub max_force: f32,
+    /// A spring towards an offset (m; N/m, N·s/m); without one the motor holds its target
+    /// velocity rigidly.
+    #[serde(default)]
+    pub spring: Option<MotorSpring>,
+}
+
+/// A motor's spring: it exerts `stiffness (target − value) + damping (target velocity −
+/// rate)`, within the motor's maximum, integrated implicitly (stable at any stiffness).
+#[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
+pub struct MotorSpring {
+    /// The angle (rad) or offset (m) it pulls towards.
+    pub target: f32,
+    /// Its stiffness (N·m/rad or N/m, ≥ 0).
+    pub stiffness: f32,
+    /// Its damping (N·m·s/rad or N·s/m, ≥ 0).
+    pub damping: f32,
+}
+
+impl MotorSpring {
+    fn validate(&self, target_range: Option<(f32, f32, &'static str)>) -> Result<()> {
+        finite("motor spring target", self.target)?;
+        if let Some((low, high, range)) = target_range
+            && !(low..=high).contains(&self.target)
+        {
+            return Err(Error::OutOfRange {
+                what: "motor spring target",
+                value: self.target,
+                range,
+            });
+        }
+        for (what, value) in [
+            ("motor spring stiffness", self.stiffness),
+            ("motor spring damping", self.damping),
+        ] {
+            finite(what, value)?;
+            non_negative(what, value)?;
+        }
+        Ok(())
+    }
+
+    fn numbers(spring: Option<Self>) -> Option<(f32, f32, f32)> {
+        spring.map(|s| (s.target, s.stiffness, s.damping))
+    }
 }
 
 fn validate_motor(target: f32, max: f32, what: &'static str) -> Result<()> {
@@ -237,6 +286,30 @@ impl RevoluteJoint {
         self.motor = Some(AngularMotor {
             target_velocity,
             max_torque,
+            spring: None,
+        });
+        self
+    }
+
+    /// Drives the hinge towards the angle `target` (rad, within [−π, π]) as a spring of
+    /// `stiffness` (N·m/rad) and `damping` (N·m·s/rad), with at most `max_torque` (N·m): a
+    /// servo. Its period about the target is 2π √(I / stiffness) for I about the hinge.
+    #[must_use]
+    pub fn with_position_motor(
+        mut self,
+        target: f32,
+        stiffness: f32,
+        damping: f32,
+        max_torque: f32,
+    ) -> Self {
+        self.motor = Some(AngularMotor {
+            target_velocity: 0.0,
+            max_torque,
+            spring: Some(MotorSpring {
+                target,
+                stiffness,
+                damping,
+            }),
         });
         self
     }
@@ -259,7 +332,13 @@ impl Describe for RevoluteJoint {
         let axial = Axial {
             axis: Some(Axis::Turn { axis_a, axis_b }),
             limits: JointLimits::pair(self.limits),
-            motor: self.motor.map(|m| (m.target_velocity, m.max_torque)),
+            motor: self.motor.map(|m| {
+                (
+                    m.target_velocity,
+                    m.max_torque,
+                    MotorSpring::numbers(m.spring),
+                )
+            }),
         };
         (Angular::Hinge { axis_a, axis_b }, Linear::Point, axial)
     }
@@ -272,6 +351,10 @@ impl Validate for RevoluteJoint {
         unit("hinge axis b", self.axis_b)?;
         if let Some(m) = self.motor {
             validate_motor(m.target_velocity, m.max_torque, "motor max torque")?;
+            if let Some(spring) = m.spring {
+                let pi = std::f32::consts::PI;
+                spring.validate(Some((-pi, pi, "−π ≤ angle ≤ π")))?;
+            }
         }
         if let Some(l) = self.limits {
             let pi = std::f32::consts::PI;
@@ -340,6 +423,29 @@ impl PrismaticJoint {
         self.motor = Some(LinearMotor {
             target_velocity,
             max_force,
+            spring: None,
+        });
+        self
+    }
+
+    /// Drives the slide towards the offset `target` (m) as a spring of `stiffness` (N/m) and
+    /// `damping` (N·s/m), with at most `max_force` (N).
+    #[must_use]
+    pub fn with_position_motor(
+        mut self,
+        target: f32,
+        stiffness: f32,
+        damping: f32,
+        max_force: f32,
+    ) -> Self {
+        self.motor = Some(LinearMotor {
+            target_velocity: 0.0,
+            max_force,
+            spring: Some(MotorSpring {
+                target,
+                stiffness,
+                damping,
+            }),
         });
         self
     }
@@ -363,7 +469,13 @@ impl Describe for PrismaticJoint {
                 axis_a: self.axis_a,
             }),
             limits: JointLimits::pair(self.limits),
-            motor: self.motor.map(|m| (m.target_velocity, m.max_force)),
+            motor: self.motor.map(|m| {
+                (
+                    m.target_velocity,
+                    m.max_force,
+                    MotorSpring::numbers(m.spring),
+                )
+            }),
         };
         let angular = Angular::Weld {
             relative: self.relative,
@@ -385,6 +497,9 @@ impl Validate for PrismaticJoint {
         crate::rigid::Rotation::try_new(self.relative)?;
         if let Some(m) = self.motor {
             validate_motor(m.target_velocity, m.max_force, "motor max force")?;
+            if let Some(spring) = m.spring {
+                spring.validate(None)?;
+            }
         }
         if let Some(l) = self.limits {
             l.validate("slider limits", None)?;

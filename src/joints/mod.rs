@@ -75,7 +75,7 @@ mod tree;
 pub use breaking::{JointBreakForce, JointBroken};
 pub use diagnostics::JointDiagnostics;
 pub use kinds::{
-    AngularMotor, DistanceJoint, FixedJoint, JointLimits, LinearMotor, PrismaticJoint,
+    AngularMotor, DistanceJoint, FixedJoint, JointLimits, LinearMotor, MotorSpring, PrismaticJoint,
     RevoluteJoint, SphericalJoint,
 };
 pub(crate) use kinds::{Kinds, bodies};

@@ -355,7 +355,7 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     }
     // Motors (and the limits no group takes) first, each on its own (Box2D's order): the
     // rows after them keep what they leave free, the free axis.
-    free_axes(s, mode, h);
+    free_axes(s, mode, h, warm);
     let mut k = 0;
     while k < s.order.len() {
         let end = group_end(s, k);
@@ -440,13 +440,19 @@ fn stiffen_sides(s: &mut Scratch, joints: &Joints, h: f32) {
 
 /// Solves every free axis's motor, and its limits unless its group takes them, each joint
 /// on its own.
-fn free_axes(s: &mut Scratch, mode: Mode, h: f32) {
+fn free_axes(s: &mut Scratch, mode: Mode, h: f32, first: bool) {
     for (j, &(rows, ia, ib)) in s.joints.iter().enumerate() {
         if rows.axial.active()
             && let Ok(sides) = s.sides.get_disjoint_mut([ia, ib])
         {
             let [a, b] = sides;
-            axial::solve(&rows, (a, b), &mut s.acc[j], (mode, h), !s.in_block[j]);
+            axial::solve(
+                &rows,
+                (a, b),
+                &mut s.acc[j],
+                (mode, h, first),
+                !s.in_block[j],
+            );
         }
     }
 }

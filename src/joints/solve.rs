@@ -90,14 +90,18 @@ pub(super) enum Axis {
     Length,
 }
 
+/// A motor spring's target (rad or m), stiffness and damping.
+pub(super) type Spring = (f32, f32, f32);
+
 /// A joint's free axis with its limits and motor, if it has one.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Axial {
     pub axis: Option<Axis>,
     /// `min ≤ value ≤ max`.
     pub limits: Option<(f32, f32)>,
-    /// Target rate (rad/s or m/s) and largest force or torque (N or N·m).
-    pub motor: Option<(f32, f32)>,
+    /// Target rate (rad/s or m/s), largest force or torque (N or N·m), and a spring's
+    /// target, stiffness and damping.
+    pub motor: Option<(f32, f32, Option<Spring>)>,
 }
 
 impl Axial {
