@@ -454,6 +454,7 @@ fn update_islands(
             }
         }
     }
+    moving_pinned.sort_unstable();
     parent.clear();
     parent.extend(0..entities.len());
     let union = |parent: &mut Vec<usize>, i: usize, j: usize| {
@@ -474,7 +475,7 @@ fn update_islands(
         if let Some(&i) = index.get(&e) {
             return JointSide::Island(i);
         }
-        if moving_pinned.contains(&e) {
+        if moving_pinned.binary_search(&e).is_ok() {
             return JointSide::Moving;
         }
         match outsiders.get(e) {

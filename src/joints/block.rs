@@ -185,6 +185,13 @@ pub(super) fn response(side: &Side, lin: Vec3A, ang: Vec3A) -> (Vec3A, Vec3A) {
     (side.inv_m * lin, side.inv_i * ang)
 }
 
+/// The memory a dense solve reuses between calls: the system and the rows still held.
+#[derive(Debug, Default)]
+pub(super) struct Dense {
+    matrix: Vec<f64>,
+    live: Vec<Row>,
+}
+
 /// Solves `rows` as one system against `bodies` in `mode`, applies the impulses and adds
 /// them to the joints' accumulators `acc`. `scratch` is reused between calls.
 pub(super) fn solve(
@@ -192,7 +199,7 @@ pub(super) fn solve(
     bodies: &mut [Side],
     acc: &mut [Accumulated],
     mode: Mode,
-    scratch: &mut Vec<f64>,
+    scratch: &mut Dense,
 ) {
     if rows
         .iter()
@@ -200,7 +207,7 @@ pub(super) fn solve(
     {
         solve_with_limits(rows, bodies, acc, mode, scratch);
     } else {
-        solve_equalities(rows, bodies, acc, mode, scratch);
+        solve_equalities(rows, bodies, acc, mode, &mut scratch.matrix);
     }
 }
 
@@ -212,12 +219,17 @@ fn solve_with_limits(
     bodies: &mut [Side],
     acc: &mut [Accumulated],
     mode: Mode,
-    scratch: &mut Vec<f64>,
+    scratch: &mut Dense,
 ) {
-    let mut live = rows.to_vec();
+    let Dense {
+        matrix: scratch,
+        live,
+    } = scratch;
+    live.clear();
+    live.extend_from_slice(rows);
     // Each round lets go of at least one row, so this ends.
     loop {
-        if !solve_system(&live, bodies, mode, scratch) {
+        if !solve_system(live, bodies, mode, scratch) {
             return;
         }
         let n = live.len();
@@ -236,7 +248,7 @@ fn solve_with_limits(
             }
         });
         if !let_go {
-            apply(&live, x, bodies, acc, mode);
+            apply(live, x, bodies, acc, mode);
             return;
         }
         for rp in rows {
@@ -474,7 +486,13 @@ mod tests {
             );
         }
         let mut acc = vec![Accumulated::default(); 2];
-        solve(&rows, &mut sides, &mut acc, Mode::RIGID, &mut Vec::new());
+        solve(
+            &rows,
+            &mut sides,
+            &mut acc,
+            Mode::RIGID,
+            &mut Dense::default(),
+        );
         assert!(relative_speed(&rows, &sides) < 1e-5);
         let after: Vec3A = sides.iter().map(|s| s.v).sum();
         assert!(
@@ -509,7 +527,13 @@ mod tests {
             &mut rows,
         );
         let (mut dense, mut acc_dense) = (sides.clone(), vec![start]);
-        solve(&rows, &mut dense, &mut acc_dense, mode, &mut Vec::new());
+        solve(
+            &rows,
+            &mut dense,
+            &mut acc_dense,
+            mode,
+            &mut Dense::default(),
+        );
         let mut acc = start;
         let [a, b] = sides.get_disjoint_mut([0, 1]).unwrap();
         super::super::solve::solve_ball(&geometry, a, b, &mut acc, mode);
@@ -540,7 +564,13 @@ mod tests {
             &mut rows,
         );
         let mut acc = vec![Accumulated::default()];
-        solve(&rows, &mut sides, &mut acc, Mode::RIGID, &mut Vec::new());
+        solve(
+            &rows,
+            &mut sides,
+            &mut acc,
+            Mode::RIGID,
+            &mut Dense::default(),
+        );
         assert!(
             (sides[1].w - Vec3A::new(0.0, 0.0, 3.0)).length() < 1e-5,
             "{}",

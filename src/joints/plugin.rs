@@ -218,7 +218,7 @@ struct Scratch {
     /// Per joint, its group's root; then the joints in group order.
     order: Vec<(usize, usize)>,
     rows: Vec<Row>,
-    matrix: Vec<f64>,
+    matrix: block::Dense,
     /// Per group root, its first joint (groups are solved in that order).
     first: HashMap<usize, usize>,
     /// Per side: counted in [`mostly_tree`].

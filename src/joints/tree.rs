@@ -59,7 +59,7 @@ pub(super) struct TreeScratch {
     place: Vec<(usize, usize)>,
     solution: Vec<f64>,
     queue: Vec<usize>,
-    single: Vec<f64>,
+    single: block::Dense,
 }
 
 const NONE: usize = usize::MAX;
@@ -552,7 +552,13 @@ mod tests {
                 5
             ];
             let mut acc_sparse = acc.clone();
-            block::solve(&rows, &mut dense, &mut acc, mode, &mut Vec::new());
+            block::solve(
+                &rows,
+                &mut dense,
+                &mut acc,
+                mode,
+                &mut block::Dense::default(),
+            );
             solve(
                 &rows,
                 &mut sparse,

@@ -61,3 +61,15 @@ pub fn awake_world(dt: f32, substeps: u32, g: Vec3) -> World {
 pub fn contact_world(substeps: u32) -> World {
     awake_world(1.0 / 60.0, substeps, Vec3::new(0.0, -9.81, 0.0))
 }
+
+/// A dynamic body of `collider` (1000 kg/m³) at `x`, spawned as game code does.
+pub fn dynamic(world: &mut World, collider: Collider, x: Vec3) -> Entity {
+    world
+        .spawn((RigidBody::Dynamic, collider, Position(x.into())))
+        .id()
+}
+
+/// Where the point `local` of body `e` (its shape frame) stands (m).
+pub fn point_of(world: &World, e: Entity, local: Vec3) -> Vec3A {
+    world.get::<Position>(e).unwrap().0 + world.get::<Rotation>(e).unwrap().0 * Vec3A::from(local)
+}

@@ -5,7 +5,7 @@ use bevy_ecs::prelude::*;
 use hooke::core::rest::Sleeping;
 use hooke::prelude::*;
 
-use crate::common::default_world;
+use crate::common::{default_world, dynamic, point_of};
 
 fn asleep(w: &World, e: Entity) -> bool {
     w.get::<Sleeping>(e).is_some()
@@ -25,13 +25,11 @@ fn chain_on_ground(w: &mut World, order: &[usize]) -> Vec<Entity> {
     ));
     let mut bars = vec![Entity::PLACEHOLDER; LINKS];
     for &i in order {
-        bars[i] = w
-            .spawn((
-                RigidBody::Dynamic,
-                Collider::cuboid(0.5, 0.1, 0.1).unwrap(),
-                Position(Vec3A::new(i as f32 * PITCH, 0.1, 0.0)),
-            ))
-            .id();
+        bars[i] = dynamic(
+            w,
+            Collider::cuboid(0.5, 0.1, 0.1).unwrap(),
+            Vec3::new(i as f32 * PITCH, 0.1, 0.0),
+        );
     }
     for &i in order.iter().filter(|&&i| i + 1 < LINKS) {
         w.spawn(SphericalJoint::new(bars[i], bars[i + 1]).with_anchors(
@@ -97,13 +95,11 @@ fn a_body_hung_on_a_kinematic_body_follows_it_when_it_starts_moving() {
             carrier.insert(Collider::ball(0.1).unwrap());
         }
         let carrier = carrier.id();
-        let bob = w
-            .spawn((
-                RigidBody::Dynamic,
-                Collider::cuboid(0.1, 0.5, 0.1).unwrap(),
-                Position(top - Vec3A::new(0.0, 0.5, 0.0)),
-            ))
-            .id();
+        let bob = dynamic(
+            &mut w,
+            Collider::cuboid(0.1, 0.5, 0.1).unwrap(),
+            Vec3::from(top) - Vec3::new(0.0, 0.5, 0.0),
+        );
         let (anchor_a, anchor_b) = (Vec3::ZERO, Vec3::new(0.0, 0.5, 0.0));
         w.spawn(SphericalJoint::new(carrier, bob).with_anchors(anchor_a, anchor_b));
         for _ in 0..90 {
@@ -116,9 +112,7 @@ fn a_body_hung_on_a_kinematic_body_follows_it_when_it_starts_moving() {
         for _ in 0..120 {
             w.step_physics();
             assert!(!asleep(&w, bob), "collider {carrier_collides}: left behind");
-            let a = w.get::<Position>(carrier).unwrap().0 + Vec3A::from(anchor_a);
-            let b = w.get::<Position>(bob).unwrap().0
-                + w.get::<Rotation>(bob).unwrap().0 * Vec3A::from(anchor_b);
+            let (a, b) = (point_of(&w, carrier, anchor_a), point_of(&w, bob, anchor_b));
             widest = widest.max((a - b).length());
         }
         println!("collider {carrier_collides}: joint parted by at most {widest} m");
@@ -135,13 +129,11 @@ fn a_body_hung_on_a_kinematic_body_follows_it_when_it_starts_moving() {
 #[test]
 fn taking_a_joint_off_a_sleeping_body_wakes_it() {
     let mut w = default_world();
-    let bob = w
-        .spawn((
-            RigidBody::Dynamic,
-            Collider::cuboid(0.1, 0.5, 0.1).unwrap(),
-            Position(Vec3A::new(0.0, 2.5, 0.0)),
-        ))
-        .id();
+    let bob = dynamic(
+        &mut w,
+        Collider::cuboid(0.1, 0.5, 0.1).unwrap(),
+        Vec3::new(0.0, 2.5, 0.0),
+    );
     let joint = w
         .spawn(
             SphericalJoint::to_world(bob)

@@ -5,11 +5,7 @@ use bevy_ecs::prelude::*;
 use hooke::prelude::*;
 
 use super::continue_bit_identically::{round_trip, via_bytes, via_ron};
-
-fn body(w: &mut World, collider: Collider, x: Vec3) -> Entity {
-    w.spawn((RigidBody::Dynamic, collider, Position(x.into())))
-        .id()
-}
+use crate::common::dynamic as body;
 
 fn bar(w: &mut World, x: Vec3) -> Entity {
     body(w, Collider::cuboid(0.5, 0.1, 0.1).unwrap(), x)
