@@ -108,6 +108,19 @@ pub(super) fn measure(rows: &Rows, a: &Side, b: &Side) -> Option<Measured> {
                 value: n.dot(d),
             })
         }
+        Axis::Twist { axis_a, axis_b } => {
+            let (n_a, n_b) = (a.q * Vec3A::from(axis_a), b.q * Vec3A::from(axis_b));
+            // The twist's rate is (n_a + n_b)·(ω_b − ω_a) / (1 + n_a·n_b): it is 1 for a turn
+            // about either axis and 0 for the swing about n_a × n_b.
+            let denominator = 1.0 + n_a.dot(n_b);
+            (denominator > 1e-3).then(|| Measured {
+                n: (n_a + n_b) / denominator,
+                linear: false,
+                r_a,
+                r_b,
+                value: hinge_angle(a.q, b.q, axis_a, axis_b),
+            })
+        }
         Axis::Length => {
             let length = d.length();
             (length > 1e-6).then(|| Measured {
@@ -121,6 +134,29 @@ pub(super) fn measure(rows: &Rows, a: &Side, b: &Side) -> Option<Measured> {
     }
 }
 
+/// A ball joint's swing as it stands with its cone's half-angle, when it has a cone and
+/// the axes are not aligned: the angle θ between them, whose rate is n·(ω_b − ω_a) for
+/// n = n_a × n_b / |n_a × n_b|.
+pub(super) fn measure_swing(rows: &Rows, a: &Side, b: &Side) -> Option<(Measured, f32)> {
+    let swing = rows.axial.swing?;
+    let (n_a, n_b) = (
+        a.q * Vec3A::from(swing.axis_a),
+        b.q * Vec3A::from(swing.axis_b),
+    );
+    let cross = n_a.cross(n_b);
+    let sin = cross.length();
+    (sin > 1e-6).then(|| {
+        let m = Measured {
+            n: cross / sin,
+            linear: false,
+            r_a: Vec3A::ZERO,
+            r_b: Vec3A::ZERO,
+            value: sin.atan2(n_a.dot(n_b)),
+        };
+        (m, swing.max)
+    })
+}
+
 /// The axis's value as it stands (rad or m), when it has one.
 #[must_use]
 pub(super) fn value(rows: &Rows, a: &Side, b: &Side) -> Option<f32> {
@@ -130,11 +166,19 @@ pub(super) fn value(rows: &Rows, a: &Side, b: &Side) -> Option<f32> {
 /// Applies the accumulated motor and limit impulses again along the axis as it now stands.
 pub(super) fn warm_start(rows: &Rows, acc: &Accumulated, a: &mut Side, b: &mut Side) {
     let total = acc.motor + acc.lower - acc.upper;
-    if total == 0.0 {
-        return;
-    }
-    if let Some(m) = measure(rows, a, b) {
+    if total != 0.0
+        && let Some(m) = measure(rows, a, b)
+    {
         m.apply(a, b, total);
+    }
+    if acc.swing != 0.0
+        && let Some((m, _)) = measure_swing(rows, a, b)
+    {
+        m.apply(a, b, -acc.swing);
+    }
+    if acc.friction != Vec3A::ZERO {
+        a.push(Vec3A::ZERO, Vec3A::ZERO, -acc.friction);
+        b.push(Vec3A::ZERO, Vec3A::ZERO, acc.friction);
     }
 }
 
@@ -142,10 +186,14 @@ pub(super) fn warm_start(rows: &Rows, acc: &Accumulated, a: &mut Side, b: &mut S
 #[must_use]
 pub(super) fn world_impulse(rows: &Rows, acc: &Accumulated, a: &Side, b: &Side) -> (Vec3, Vec3) {
     let total = acc.motor + acc.lower - acc.upper;
+    let swing = match measure_swing(rows, a, b) {
+        Some((m, _)) if acc.swing != 0.0 => Vec3::from(-acc.swing * m.n),
+        _ => Vec3::ZERO,
+    } + Vec3::from(acc.friction);
     match measure(rows, a, b) {
-        Some(m) if total != 0.0 && m.linear => ((total * m.n).into(), Vec3::ZERO),
-        Some(m) if total != 0.0 => (Vec3::ZERO, (total * m.n).into()),
-        _ => (Vec3::ZERO, Vec3::ZERO),
+        Some(m) if total != 0.0 && m.linear => ((total * m.n).into(), swing),
+        Some(m) if total != 0.0 => (Vec3::ZERO, Vec3::from(total * m.n) + swing),
+        _ => (Vec3::ZERO, swing),
     }
 }
 
@@ -167,7 +215,8 @@ fn spring_impulse(spring: (f32, f32, f32), m: &Measured, rate: f32, k: f32, h: f
 }
 
 /// Solves the axis's motor, then (with `limits`; a group solve takes them otherwise) its
-/// lower and upper limits, each on its own. `first`: the substep's first (biased) pass.
+/// lower and upper limits and a ball joint's cone, each on its own. `first`: the substep's
+/// first (biased) pass.
 pub(super) fn solve(
     rows: &Rows,
     (a, b): (&mut Side, &mut Side),
@@ -175,49 +224,109 @@ pub(super) fn solve(
     (mode, h, first): (Mode, f32, bool),
     limits: bool,
 ) {
-    let Some(m) = measure(rows, a, b) else {
-        return;
-    };
-    let Some(k) = m.inverse_mass(a, b) else {
-        return;
-    };
-    if let Some((target, max, spring)) = rows.axial.motor {
-        let limit = max * h;
-        let held = acc.motor;
-        let rate = m.rate(a, b) - target;
-        let total = match spring {
-            // Rigid in every pass: a velocity target, with no position to correct.
-            None => Some(held - rate / k),
-            // A spring–damper is a force: applied once a substep, in the first pass (a
-            // second solve after the positions move would damp it).
-            Some(spring) => first.then(|| spring_impulse(spring, &m, rate - k * held, k, h)),
-        };
-        if let Some(total) = total {
-            acc.motor = total.clamp(-limit, limit);
-            m.apply(a, b, acc.motor - held);
+    if let Some(max) = rows.axial.friction {
+        friction(max * h, (a, b), &mut acc.friction);
+    }
+    if let Some(m) = measure(rows, a, b)
+        && let Some(k) = m.inverse_mass(a, b)
+    {
+        if let Some((target, max, spring)) = rows.axial.motor {
+            let limit = max * h;
+            let held = acc.motor;
+            let rate = m.rate(a, b) - target;
+            let total = match spring {
+                // Rigid in every pass: a velocity target, with no position to correct.
+                None => Some(held - rate / k),
+                // A spring–damper is a force: applied once a substep, in the first pass (a
+                // second solve after the positions move would damp it).
+                Some(spring) => first.then(|| spring_impulse(spring, &m, rate - k * held, k, h)),
+            };
+            if let Some(total) = total {
+                acc.motor = total.clamp(-limit, limit);
+                m.apply(a, b, acc.motor - held);
+            }
+        }
+        if let Some((min, max)) = rows.axial.limits.filter(|_| limits) {
+            stop(
+                &m,
+                k,
+                (a, b),
+                (1.0, m.value - min),
+                &mut acc.lower,
+                (mode, h),
+            );
+            stop(
+                &m,
+                k,
+                (a, b),
+                (-1.0, max - m.value),
+                &mut acc.upper,
+                (mode, h),
+            );
         }
     }
-    let Some((min, max)) = rows.axial.limits.filter(|_| limits) else {
-        return;
-    };
-    for (sign, c, held) in [
-        (1.0, m.value - min, &mut acc.lower),
-        (-1.0, max - m.value, &mut acc.upper),
-    ] {
-        let (bias, mass_scale, impulse_scale) = if c > 0.0 {
-            (c / h, 1.0, 0.0)
-        } else {
-            (mode.bias_rate * c, mode.mass_scale, mode.impulse_scale)
-        };
-        let rate = sign * m.rate(a, b);
-        let lambda = -mass_scale * (rate + bias) / k - impulse_scale * *held;
-        let total = (*held + lambda).max(0.0);
-        if !total.is_finite() {
-            continue;
-        }
-        m.apply(a, b, sign * (total - *held));
-        *held = total;
+    if limits
+        && let Some((m, max)) = measure_swing(rows, a, b)
+        && let Some(k) = m.inverse_mass(a, b)
+    {
+        stop(
+            &m,
+            k,
+            (a, b),
+            (-1.0, max - m.value),
+            &mut acc.swing,
+            (mode, h),
+        );
     }
+}
+
+/// A ball joint's friction: the angular impulse that stops the sides' relative spin,
+/// its accumulated total `held` kept within `limit` (N·m·s) in length.
+fn friction(limit: f32, (a, b): (&mut Side, &mut Side), held: &mut Vec3A) {
+    let mut k = glam::Mat3A::ZERO;
+    for side in [&*a, &*b] {
+        if side.moves {
+            k += side.inv_i;
+        }
+    }
+    let det = k.determinant();
+    if !(det.is_finite() && det > 0.0) {
+        return;
+    }
+    let lambda = k.inverse() * (a.w - b.w);
+    let total = (*held + lambda).clamp_length_max(limit);
+    if !total.is_finite() {
+        return;
+    }
+    let delta = total - *held;
+    a.push(Vec3A::ZERO, Vec3A::ZERO, -delta);
+    b.push(Vec3A::ZERO, Vec3A::ZERO, delta);
+    *held = total;
+}
+
+/// One limit of the axis `m` (inverse mass `k`) as a one-sided row: `sign` +1 for a lower
+/// stop, −1 for an upper one, `c` the distance left to it, `held` its accumulated impulse.
+fn stop(
+    m: &Measured,
+    k: f32,
+    (a, b): (&mut Side, &mut Side),
+    (sign, c): (f32, f32),
+    held: &mut f32,
+    (mode, h): (Mode, f32),
+) {
+    let (bias, mass_scale, impulse_scale) = if c > 0.0 {
+        (c / h, 1.0, 0.0)
+    } else {
+        (mode.bias_rate * c, mode.mass_scale, mode.impulse_scale)
+    };
+    let rate = sign * m.rate(a, b);
+    let lambda = -mass_scale * (rate + bias) / k - impulse_scale * *held;
+    let total = (*held + lambda).max(0.0);
+    if !total.is_finite() {
+        return;
+    }
+    m.apply(a, b, sign * (total - *held));
+    *held = total;
 }
 
 #[cfg(test)]
@@ -236,5 +345,60 @@ mod tests {
         let arc = Quat::from_rotation_arc(Vec3::X, Vec3::Z);
         let qb = Quat::from_rotation_z(0.5) * arc;
         assert!((hinge_angle(Quat::IDENTITY, qb, Vec3::Z, Vec3::X) - 0.5).abs() < 1e-5);
+    }
+
+    #[test]
+    fn the_twist_and_swing_rates_are_the_derivatives_of_their_angles() {
+        use super::super::solve::{Angular, Axial, Linear, Swing};
+        let (axis_a, axis_b) = (Vec3::new(0.0, -0.6, 0.8), Vec3::NEG_Y);
+        let rows = Rows {
+            local_a: Vec3A::ZERO,
+            local_b: Vec3A::ZERO,
+            angular: Angular::Free,
+            linear: Linear::Point,
+            axial: Axial {
+                axis: Some(Axis::Twist { axis_a, axis_b }),
+                limits: Some((-1.0, 1.0)),
+                swing: Some(Swing {
+                    axis_a,
+                    axis_b,
+                    max: 1.0,
+                }),
+                ..Axial::NONE
+            },
+        };
+        let side = |q: Quat, w: Vec3| Side {
+            q,
+            w: w.into(),
+            ..Side::WORLD
+        };
+        let (qa, qb) = (
+            Quat::from_euler(glam::EulerRot::XYZ, 0.3, -0.5, 0.9),
+            Quat::from_euler(glam::EulerRot::XYZ, -0.2, 0.4, 1.3),
+        );
+        let (wa, wb) = (Vec3::new(0.4, -1.1, 0.7), Vec3::new(-0.9, 0.3, 1.6));
+        let (a, b) = (side(qa, wa), side(qb, wb));
+        let eps = 1e-3;
+        let turn = |q: Quat, w: Vec3, t: f32| Quat::from_scaled_axis(w * t) * q;
+        let later = |t: f32| (side(turn(qa, wa, t), wa), side(turn(qb, wb, t), wb));
+        let ((a1, b1), (a0, b0)) = (later(eps), later(-eps));
+        let twist = measure(&rows, &a, &b).unwrap();
+        let numeric = (measure(&rows, &a1, &b1).unwrap().value
+            - measure(&rows, &a0, &b0).unwrap().value)
+            / (2.0 * eps);
+        assert!(
+            (twist.rate(&a, &b) - numeric).abs() < 2e-3,
+            "{} against {numeric}",
+            twist.rate(&a, &b)
+        );
+        let (swing, _) = measure_swing(&rows, &a, &b).unwrap();
+        let numeric = (measure_swing(&rows, &a1, &b1).unwrap().0.value
+            - measure_swing(&rows, &a0, &b0).unwrap().0.value)
+            / (2.0 * eps);
+        assert!(
+            (swing.rate(&a, &b) - numeric).abs() < 2e-3,
+            "{} against {numeric}",
+            swing.rate(&a, &b)
+        );
     }
 }

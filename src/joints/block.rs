@@ -27,6 +27,15 @@ pub(super) enum Held {
     Angular,
     Lower,
     Upper,
+    /// A ball joint's cone (one-sided too).
+    Swing,
+}
+
+impl Held {
+    /// Whether its row is a limit: one-sided, its total impulse ≥ 0.
+    pub fn one_sided(self) -> bool {
+        matches!(self, Held::Lower | Held::Upper | Held::Swing)
+    }
 }
 
 /// One constraint row: its Jacobian on each side, the joint it belongs to and what its
@@ -55,13 +64,13 @@ pub(super) struct Row {
 
 /// The rows of one joint between sides `a` and `b` (indices into the pass's bodies; `None`
 /// for an immovable side), with its limits' rows when `limits` holds the substep length
-/// and its accumulated limit impulses (lower, upper).
+/// and its accumulated impulses.
 pub(super) fn joint_rows(
     joint: usize,
     rows: &Rows,
     (ia, a): (Option<usize>, &Side),
     (ib, b): (Option<usize>, &Side),
-    limits: Option<(f32, f32, f32)>,
+    limits: Option<(f32, &Accumulated)>,
     out: &mut Vec<Row>,
 ) {
     let base = Row {
@@ -133,40 +142,26 @@ pub(super) fn joint_rows(
         }
         Linear::Free => {}
     }
-    if let (Some((h, lower, upper)), Some((min, max))) = (limits, rows.axial.limits)
-        && let Some(m) = super::axial::measure(rows, a, b)
-    {
-        // The nearer stop only (or the one pushing): the two cannot both hold.
-        let near_lower = if lower > 0.0 || upper > 0.0 {
-            lower >= upper
-        } else {
-            m.value - min <= max - m.value
-        };
-        let (held, sign, c, acc) = if near_lower {
-            (Held::Lower, 1.0, m.value - min, lower)
-        } else {
-            (Held::Upper, -1.0, max - m.value, upper)
-        };
-        let n = sign * m.n;
-        // Far from its stop and not pushing: it cannot reach the stop in this substep.
-        let closing = -sign * m.rate(a, b);
-        if acc > 0.0 || c <= 2.0 * h * closing.max(0.0) {
-            let (lin_a, ang_a, lin_b, ang_b) = if m.linear {
-                (-n, -m.r_a.cross(n), n, m.r_b.cross(n))
+    if let Some((h, acc)) = limits {
+        if let Some((min, max)) = rows.axial.limits
+            && let Some(m) = super::axial::measure(rows, a, b)
+        {
+            // The nearer stop only (or the one pushing): the two cannot both hold.
+            let near_lower = if acc.lower > 0.0 || acc.upper > 0.0 {
+                acc.lower >= acc.upper
             } else {
-                (Vec3A::ZERO, -n, Vec3A::ZERO, n)
+                m.value - min <= max - m.value
             };
-            out.push(Row {
-                lin_a,
-                ang_a,
-                lin_b,
-                ang_b,
-                dir: n,
-                held,
-                c,
-                speculative: (c > 0.0).then(|| c / h),
-                ..base
-            });
+            let stop = if near_lower {
+                (Held::Lower, 1.0, m.value - min, acc.lower)
+            } else {
+                (Held::Upper, -1.0, max - m.value, acc.upper)
+            };
+            push_stop(&base, &m, stop, (a, b, h), out);
+        }
+        if let Some((m, max)) = super::axial::measure_swing(rows, a, b) {
+            let stop = (Held::Swing, -1.0, max - m.value, acc.swing);
+            push_stop(&base, &m, stop, (a, b, h), out);
         }
     }
     for row in &mut out[start..] {
@@ -176,6 +171,39 @@ pub(super) fn joint_rows(
         if ib.is_none() {
             row.carried += row.lin_b.dot(b.v) + row.ang_b.dot(b.w);
         }
+    }
+}
+
+/// Appends the one-sided row of a stop on the axis `m`: `held` what it adds to, `sign` +1
+/// for a lower stop and −1 for an upper one, `c` the distance left to it, `acc` the impulse
+/// it holds. Left out while it is far from its stop and not pushing: it cannot reach the
+/// stop in this substep.
+fn push_stop(
+    base: &Row,
+    m: &super::axial::Measured,
+    (held, sign, c, acc): (Held, f32, f32, f32),
+    (a, b, h): (&Side, &Side, f32),
+    out: &mut Vec<Row>,
+) {
+    let n = sign * m.n;
+    let closing = -sign * m.rate(a, b);
+    if acc > 0.0 || c <= 2.0 * h * closing.max(0.0) {
+        let (lin_a, ang_a, lin_b, ang_b) = if m.linear {
+            (-n, -m.r_a.cross(n), n, m.r_b.cross(n))
+        } else {
+            (Vec3A::ZERO, -n, Vec3A::ZERO, n)
+        };
+        out.push(Row {
+            lin_a,
+            ang_a,
+            lin_b,
+            ang_b,
+            dir: n,
+            held,
+            c,
+            speculative: (c > 0.0).then(|| c / h),
+            ..*base
+        });
     }
 }
 
@@ -201,10 +229,7 @@ pub(super) fn solve(
     mode: Mode,
     scratch: &mut Dense,
 ) {
-    if rows
-        .iter()
-        .any(|r| matches!(r.held, Held::Lower | Held::Upper))
-    {
+    if rows.iter().any(|r| r.held.one_sided()) {
         solve_with_limits(rows, bodies, acc, mode, scratch);
     } else {
         solve_equalities(rows, bodies, acc, mode, &mut scratch.matrix);
@@ -239,8 +264,7 @@ fn solve_with_limits(
         live.retain(|rp| {
             let i = k;
             k += 1;
-            let one_sided = matches!(rp.held, Held::Lower | Held::Upper);
-            if one_sided && held(rp, acc) + lambda(rp, x[i], acc, mode) < 0.0 {
+            if rp.held.one_sided() && held(rp, acc) + lambda(rp, x[i], acc, mode) < 0.0 {
                 let_go = true;
                 false
             } else {
@@ -252,7 +276,7 @@ fn solve_with_limits(
             return;
         }
         for rp in rows {
-            let one_sided = matches!(rp.held, Held::Lower | Held::Upper);
+            let one_sided = rp.held.one_sided();
             let gone = !live
                 .iter()
                 .any(|l| l.joint == rp.joint && l.held == rp.held);
@@ -336,6 +360,7 @@ fn held(rp: &Row, acc: &[Accumulated]) -> f32 {
         Held::Angular => rp.dir.dot(acc.angular),
         Held::Lower => acc.lower,
         Held::Upper => acc.upper,
+        Held::Swing => acc.swing,
     }
 }
 
@@ -367,6 +392,7 @@ fn push(rp: &Row, lambda: f32, bodies: &mut [Side], acc: &mut [Accumulated]) {
         Held::Angular => acc.angular += lambda * rp.dir,
         Held::Lower => acc.lower += lambda,
         Held::Upper => acc.upper += lambda,
+        Held::Swing => acc.swing += lambda,
     }
 }
 

@@ -77,9 +77,12 @@ fn errors(rows: &Rows, a: &Side, b: &Side) -> (f32, f32) {
     {
         let past = (min - value).max(value - max).max(0.0);
         match axis {
-            Axis::Turn { .. } => angle += past,
+            Axis::Turn { .. } | Axis::Twist { .. } => angle += past,
             Axis::Slide { .. } | Axis::Length => gap += past,
         }
+    }
+    if let Some((swing, max)) = axial::measure_swing(rows, a, b) {
+        angle += (swing.value - max).max(0.0);
     }
     (gap, angle)
 }

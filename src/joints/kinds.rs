@@ -3,7 +3,7 @@
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3, Vec3A};
 
-use super::solve::{Angular, Axial, Axis, Linear, Rows};
+use super::solve::{Angular, Axial, Axis, Linear, Rows, Swing};
 use super::{Joint, JointBodies, JointImpulse, joint_discarded, joint_inserted};
 use crate::core::error::{Error, Result, finite, finite_vec, non_negative};
 use crate::core::quarantine::Validate;
@@ -187,13 +187,54 @@ fn validate_motor(target: f32, max: f32, what: &'static str) -> Result<()> {
     non_negative(what, max).map(|_| ())
 }
 
-/// A ball joint: `b`'s anchor stays on `a`'s, every turn is free.
+/// A ball joint: `b`'s anchor stays on `a`'s, every turn is free, within its cone and
+/// twist limits if it has them.
+///
+/// The limits are about the joint's axis, `axis_a` on `a` and `axis_b` on `b` (`Vec3::Y`
+/// in both shape frames unless set, a limb hanging along y): the **swing** is the angle
+/// between the two axes, kept within a cone of half-angle [`Self::swing_limit`]; the
+/// **twist** is `b`'s turn about its axis once that axis is swung back onto `a`'s by the
+/// shortest arc (right-handed, rad), kept within [`Self::twist_limits`]. Both are zero
+/// where `b` stands relative to `a` as when both were spawned with [`Self::new`] and one
+/// axis.
+///
+/// ```
+/// # use bevy_ecs::prelude::*;
+/// # use hooke::prelude::*;
+/// # let mut world = World::new();
+/// # let (torso, arm) = (world.spawn_empty().id(), world.spawn_empty().id());
+/// // A shoulder: the arm hangs along −y, swings up to 80° from it, twists ±30°.
+/// let shoulder = SphericalJoint::new(torso, arm)
+///     .with_axis(Vec3::NEG_Y)
+///     .with_swing_limit(80_f32.to_radians())
+///     .with_twist_limits(-30_f32.to_radians(), 30_f32.to_radians());
+/// ```
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[require(JointImpulse)]
 #[component(on_insert = joint_inserted::<Self>, on_discard = joint_discarded::<Self>)]
 pub struct SphericalJoint {
     /// The bodies and anchors.
     pub bodies: JointBodies,
+    /// The joint's axis in `a`'s shape frame (world frame for a world joint); unit length.
+    #[serde(default = "y_axis")]
+    pub axis_a: Vec3,
+    /// The joint's axis in `b`'s shape frame; unit length.
+    #[serde(default = "y_axis")]
+    pub axis_b: Vec3,
+    /// The cone's half-angle (rad, in (0, π)): the swing between the axes stays within it.
+    #[serde(default)]
+    pub swing_limit: Option<f32>,
+    /// The range of the twist about the axis (rad, within [−π, π]).
+    #[serde(default)]
+    pub twist_limits: Option<JointLimits>,
+    /// The largest torque (N·m) with which the joint resists turning (joint friction: a
+    /// motor holding the relative spin at zero), if any.
+    #[serde(default)]
+    pub friction: Option<f32>,
+}
+
+fn y_axis() -> Vec3 {
+    Vec3::Y
 }
 
 impl SphericalJoint {
@@ -202,6 +243,11 @@ impl SphericalJoint {
     pub fn new(a: Entity, b: Entity) -> Self {
         Self {
             bodies: sides(Some(a), b),
+            axis_a: Vec3::Y,
+            axis_b: Vec3::Y,
+            swing_limit: None,
+            twist_limits: None,
+            friction: None,
         }
     }
 
@@ -210,7 +256,39 @@ impl SphericalJoint {
     pub fn to_world(b: Entity) -> Self {
         Self {
             bodies: sides(None, b),
+            ..Self::new(b, b)
         }
+    }
+
+    /// Sets the joint's axis, the same direction in both shape frames (both bodies as
+    /// spawned; for a world joint, the world frame and `b`'s frame unturned).
+    #[must_use]
+    pub fn with_axis(mut self, axis: Vec3) -> Self {
+        self.axis_a = axis.normalize_or_zero();
+        self.axis_b = self.axis_a;
+        self
+    }
+
+    /// Keeps the swing, the angle between the sides' axes, within `max` (rad, in (0, π)).
+    #[must_use]
+    pub fn with_swing_limit(mut self, max: f32) -> Self {
+        self.swing_limit = Some(max);
+        self
+    }
+
+    /// Keeps the twist about the axis within `min..=max` (rad, within [−π, π]).
+    #[must_use]
+    pub fn with_twist_limits(mut self, min: f32, max: f32) -> Self {
+        self.twist_limits = Some(JointLimits { min, max });
+        self
+    }
+
+    /// Resists any relative turn with up to `max_torque` (N·m): joint friction, which lets a
+    /// ragdoll's limbs come to rest (Box3D's humans use the same, a motor towards zero spin).
+    #[must_use]
+    pub fn with_friction(mut self, max_torque: f32) -> Self {
+        self.friction = Some(max_torque);
+        self
     }
 }
 joint_builders!(SphericalJoint);
@@ -220,13 +298,45 @@ impl Describe for SphericalJoint {
         &self.bodies
     }
     fn rows(&self) -> (Angular, Linear, Axial) {
-        (Angular::Free, Linear::Point, Axial::NONE)
+        let (axis_a, axis_b) = (self.axis_a, self.axis_b);
+        let axial = Axial {
+            axis: self.twist_limits.map(|_| Axis::Twist { axis_a, axis_b }),
+            limits: JointLimits::pair(self.twist_limits),
+            swing: self.swing_limit.map(|max| Swing {
+                axis_a,
+                axis_b,
+                max,
+            }),
+            friction: self.friction,
+            ..Axial::NONE
+        };
+        (Angular::Free, Linear::Point, axial)
     }
 }
 
 impl Validate for SphericalJoint {
     fn validate(&self) -> Result<()> {
-        self.bodies.validate()
+        self.bodies.validate()?;
+        unit("ball joint axis a", self.axis_a)?;
+        unit("ball joint axis b", self.axis_b)?;
+        let pi = std::f32::consts::PI;
+        if let Some(max) = self.swing_limit {
+            finite("swing limit", max)?;
+            if !(max > 0.0 && max < pi) {
+                return Err(Error::OutOfRange {
+                    what: "swing limit",
+                    value: max,
+                    range: "0 < swing limit < π",
+                });
+            }
+        }
+        if let Some(l) = self.twist_limits {
+            l.validate("twist limits", Some((-pi, pi, "−π ≤ angle ≤ π")))?;
+        }
+        if let Some(f) = self.friction {
+            validate_motor(0.0, f, "joint friction torque")?;
+        }
+        Ok(())
     }
 }
 
@@ -339,6 +449,7 @@ impl Describe for RevoluteJoint {
                     MotorSpring::numbers(m.spring),
                 )
             }),
+            ..Axial::NONE
         };
         (Angular::Hinge { axis_a, axis_b }, Linear::Point, axial)
     }
@@ -476,6 +587,7 @@ impl Describe for PrismaticJoint {
                     MotorSpring::numbers(m.spring),
                 )
             }),
+            ..Axial::NONE
         };
         let angular = Angular::Weld {
             relative: self.relative,
@@ -559,7 +671,7 @@ impl Describe for DistanceJoint {
         let axial = Axial {
             axis: Some(Axis::Length),
             limits: Some((self.limits.min, self.limits.max)),
-            motor: None,
+            ..Axial::NONE
         };
         (Angular::Free, Linear::Free, axial)
     }

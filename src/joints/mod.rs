@@ -3,7 +3,7 @@
 //!
 //! | joint | holds | leaves free |
 //! |---|---|---|
-//! | [`SphericalJoint`] (ball) | the anchors together | every turn |
+//! | [`SphericalJoint`] (ball) | the anchors together | every turn (within a cone and a twist range if limited) |
 //! | [`RevoluteJoint`] (hinge) | the anchors together, the hinge axes aligned | the turn about the axis |
 //! | [`PrismaticJoint`] (slider) | the relative rotation, `b`'s anchor on `a`'s axis | the slide along the axis |
 //! | [`DistanceJoint`] (rod, rope) | the anchors' distance within its limits | every turn |
@@ -11,7 +11,9 @@
 //!
 //! A hinge's angle, a slider's offset and a distance joint's length are a joint's free axis:
 //! it takes [`JointLimits`] (`with_limits`) and, on hinges and sliders, a motor
-//! (`with_motor`: [`AngularMotor`], [`LinearMotor`]), solved before the locked rows.
+//! (`with_motor`: [`AngularMotor`], [`LinearMotor`]), solved before the locked rows. A ball
+//! joint takes a cone (`with_swing_limit`), a twist range (`with_twist_limits`) about its
+//! axis, and friction (`with_friction`).
 //!
 //! A joint is an entity of its own: spawn `RevoluteJoint::new(door, frame).with_anchors(..)`
 //! (or `::to_world(body)` for a body hinged to the world). Anchors are in each body's shape
@@ -188,6 +190,12 @@ pub struct JointImpulse {
     /// The upper limit's impulse along the free axis (≥ 0, towards smaller values).
     #[serde(default)]
     pub upper: f32,
+    /// A ball joint's cone limit's impulse (≥ 0, N·m·s, closing the cone).
+    #[serde(default)]
+    pub swing: f32,
+    /// A ball joint's friction's angular impulse (N·m·s, world frame).
+    #[serde(default)]
+    pub friction: Vec3,
     /// The motor's and limits' impulse as a world vector: linear (N·s; a slider, a distance
     /// joint) ...
     #[serde(default)]

@@ -295,6 +295,8 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
             motor: impulse.motor,
             lower: impulse.lower,
             upper: impulse.upper,
+            swing: impulse.swing,
+            friction: impulse.friction.into(),
         });
     }
     stiffen_sides(s, joints, h);
@@ -403,6 +405,8 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
         impulse.motor = acc.motor;
         impulse.lower = acc.lower;
         impulse.upper = acc.upper;
+        impulse.swing = acc.swing;
+        impulse.friction = acc.friction.into();
         (impulse.axial_linear, impulse.axial_angular) =
             axial::world_impulse(&rows, acc, &s.sides[ia], &s.sides[ib]);
         impulse.h = h;
@@ -498,7 +502,7 @@ fn mostly_tree(s: &mut Scratch, k: usize, end: usize) -> bool {
 fn push_rows(s: &mut Scratch, j: usize, h: f32) {
     let (rows, ia, ib) = s.joints[j];
     let moving = |i: usize| s.sides[i].moves.then_some(i);
-    let limits = s.in_block[j].then(|| (h, s.acc[j].lower, s.acc[j].upper));
+    let limits = s.in_block[j].then_some((h, &s.acc[j]));
     block::joint_rows(
         j,
         &rows,

@@ -88,6 +88,18 @@ pub(super) enum Axis {
     Slide { axis_a: Vec3 },
     /// The distance between the anchors (m).
     Length,
+    /// A ball joint's twist: `b`'s turn about its axis once that axis is brought back onto
+    /// `a`'s by the shortest arc (rad; the twist of the swing–twist split).
+    Twist { axis_a: Vec3, axis_b: Vec3 },
+}
+
+/// A ball joint's cone: the angle between the sides' axes (each side's shape frame) kept
+/// at most `max` (rad).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Swing {
+    pub axis_a: Vec3,
+    pub axis_b: Vec3,
+    pub max: f32,
 }
 
 /// A motor spring's target (rad or m), stiffness and damping.
@@ -102,6 +114,10 @@ pub(super) struct Axial {
     /// Target rate (rad/s or m/s), largest force or torque (N or N·m), and a spring's
     /// target, stiffness and damping.
     pub motor: Option<(f32, f32, Option<Spring>)>,
+    /// A ball joint's cone limit, if any.
+    pub swing: Option<Swing>,
+    /// A ball joint's friction: the largest torque resisting any relative turn (N·m).
+    pub friction: Option<f32>,
 }
 
 impl Axial {
@@ -110,11 +126,15 @@ impl Axial {
         axis: None,
         limits: None,
         motor: None,
+        swing: None,
+        friction: None,
     };
 
     /// Whether it has any row to solve.
     pub fn active(&self) -> bool {
-        self.axis.is_some() && (self.limits.is_some() || self.motor.is_some())
+        self.swing.is_some()
+            || self.friction.is_some()
+            || (self.axis.is_some() && (self.limits.is_some() || self.motor.is_some()))
     }
 }
 
@@ -181,6 +201,10 @@ pub(super) struct Accumulated {
     /// from its limit).
     pub lower: f32,
     pub upper: f32,
+    /// A ball joint's cone limit's impulse (≥ 0, closing the cone).
+    pub swing: f32,
+    /// A ball joint's friction's angular impulse (world frame).
+    pub friction: Vec3A,
 }
 
 /// [`Softness`] for a biased pass, or the rigid solve of a relax pass.

@@ -85,7 +85,7 @@ use columns::Columns;
 
 /// The version [`Snapshot::to_bytes`] writes and [`Snapshot::from_bytes`] reads. It changes
 /// whenever the stored state changes shape.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 
 const MAGIC: [u8; 8] = *b"HOOKESNP";
 const HEADER: usize = 8 + 4 + 8 + 4;

@@ -1,0 +1,101 @@
+//! A pile of ragdolls (ball joints with cones, twists and friction, hinges with limits,
+//! contacts between all of them) at the defaults: nothing comes apart, nothing is
+//! quarantined, no limb stays past its limits and the pile comes to rest.
+
+use bevy_ecs::prelude::*;
+use hooke::prelude::*;
+use hooke::tools::joint_scenes::{Ragdoll, RagdollPile};
+
+use crate::common::default_world;
+
+/// What a pile of ragdolls did in 6 s: the widest any joint's anchors parted (m), the
+/// widest any joint stood past its limits (rad), the same over the last second, and the
+/// parts' mean and largest speed at the end (m/s).
+struct Dropped {
+    gap: f32,
+    angle: f32,
+    settled_angle: f32,
+    mean_speed: f32,
+    fastest: f32,
+}
+
+fn drop_pile(mut world: World, ragdolls: usize) -> Dropped {
+    let (parts, joints) = RagdollPile { ragdolls }.spawn(&mut world).unwrap();
+    assert_eq!(parts.len(), ragdolls * Ragdoll::PARTS.len());
+    let dt = world.resource::<PhysicsTime>().dt();
+    let steps = (6.0 / dt).round() as usize;
+    let (mut gap, mut angle, mut settled_angle) = (0.0_f32, 0.0_f32, 0.0_f32);
+    for step in 0..steps {
+        world.step_physics();
+        let d = *world.resource::<JointDiagnostics>();
+        assert_eq!(d.joints, joints.len());
+        gap = gap.max(d.largest_gap);
+        angle = angle.max(d.largest_angle);
+        if (step as f32) * dt >= 5.0 {
+            settled_angle = settled_angle.max(d.largest_angle);
+        }
+    }
+    let (mut total, mut fastest) = (0.0_f32, 0.0_f32);
+    for &e in &parts {
+        assert!(world.get::<Quarantined>(e).is_none(), "{e} quarantined");
+        let x = world.get::<Position>(e).unwrap().0;
+        assert!(x.is_finite() && x.y > -0.05, "{e} at {x}");
+        let v = world.get::<LinearVelocity>(e).unwrap().0.length();
+        total += v;
+        fastest = fastest.max(v);
+    }
+    Dropped {
+        gap,
+        angle,
+        settled_angle,
+        mean_speed: total / parts.len() as f32,
+        fastest,
+    }
+}
+
+#[test]
+fn a_pile_of_twenty_ragdolls_holds_together_and_comes_to_rest() {
+    // Measured at the defaults: anchors parted by 10.2 mm at most (in the impacts; 7.6 mm
+    // held under the pile), 6.3° past a limit at most, 2.5° after 5 s; at 6 s the parts move
+    // at 0.16 m/s at most. The goal is < 1 cm: not met by 0.2 mm (see CHANGELOG).
+    let d = drop_pile(default_world(), 20);
+    println!(
+        "20 ragdolls: anchors parted by {:.2} mm at most, {:.2}° past a limit at most ({:.2}° in the last second), speed at 6 s: mean {:.4} m/s, largest {:.4} m/s",
+        d.gap * 1e3,
+        d.angle.to_degrees(),
+        d.settled_angle.to_degrees(),
+        d.mean_speed,
+        d.fastest
+    );
+    assert!(d.gap < 0.015, "anchors parted by {} m", d.gap);
+    assert!(
+        d.angle < 10f32.to_radians() && d.settled_angle < 4f32.to_radians(),
+        "{}° past a limit ({}° in the last second)",
+        d.angle.to_degrees(),
+        d.settled_angle.to_degrees()
+    );
+    assert!(
+        d.mean_speed < 0.02 && d.fastest < 0.3,
+        "still moving: mean {} m/s, largest {} m/s",
+        d.mean_speed,
+        d.fastest
+    );
+}
+
+#[test]
+fn a_lone_ragdoll_dropped_on_the_ground_lies_still() {
+    // One ragdoll falls 0.4 m onto its back. Measured: anchors 1.8 mm apart at most (as it
+    // lands; 0.44 mm lying), no limit passed by more than 0.01°, parts at 0.02 m/s at most after 6 s (a joint and the
+    // ground's contacts each undo a little of the other every substep, so the ragdoll lies
+    // still but its velocities read a little above zero and it does not fall asleep).
+    let d = drop_pile(default_world(), 1);
+    println!(
+        "1 ragdoll: anchors parted by {:.2} mm, {:.3}° past a limit, largest speed at 6 s {:.4} m/s",
+        d.gap * 1e3,
+        d.angle.to_degrees(),
+        d.fastest
+    );
+    assert!(d.gap < 3e-3, "anchors parted by {} m", d.gap);
+    assert!(d.angle < 0.5f32.to_radians());
+    assert!(d.fastest < 0.03, "still moving at {} m/s", d.fastest);
+}
