@@ -417,6 +417,7 @@ fn main() {
     }
     if run("joints") {
         joints::chain_vs_rapier(if quick { 3 } else { 5 }, if quick { 60 } else { 300 });
+        joints::ragdolls_vs_rapier(if quick { 3 } else { 5 }, if quick { 60 } else { 300 });
     }
     if run("scaling") {
         scaling::scaling_lines(&cfg, quick);

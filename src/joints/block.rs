@@ -259,31 +259,46 @@ fn solve_with_limits(
         }
         let n = live.len();
         let x = &scratch[n * n..];
-        let mut let_go = false;
-        let mut k = 0;
-        live.retain(|rp| {
-            let i = k;
-            k += 1;
-            if rp.held.one_sided() && held(rp, acc) + lambda(rp, x[i], acc, mode) < 0.0 {
-                let_go = true;
-                false
-            } else {
-                true
-            }
-        });
-        if !let_go {
+        if !let_go_pulling(live, x, acc, mode) {
             apply(live, x, bodies, acc, mode);
             return;
         }
-        for rp in rows {
-            let one_sided = rp.held.one_sided();
-            let gone = !live
-                .iter()
-                .any(|l| l.joint == rp.joint && l.held == rp.held);
-            let h = held(rp, acc);
-            if one_sided && gone && h != 0.0 {
-                push(rp, -h, bodies, acc);
-            }
+        release(rows, live, bodies, acc);
+    }
+}
+
+/// Drops from `live` the one-sided rows whose total impulse would pull with the solution
+/// `x` (a row with a NaN solution, one the solve left out, stays); true if any was dropped.
+pub(super) fn let_go_pulling(
+    live: &mut Vec<Row>,
+    x: &[f64],
+    acc: &[Accumulated],
+    mode: Mode,
+) -> bool {
+    let mut let_go = false;
+    let mut k = 0;
+    live.retain(|rp| {
+        let i = k;
+        k += 1;
+        if rp.held.one_sided() && held(rp, acc) + lambda(rp, x[i], acc, mode) < 0.0 {
+            let_go = true;
+            false
+        } else {
+            true
+        }
+    });
+    let_go
+}
+
+/// Takes back the impulse held by each one-sided row of `rows` no longer in `live`.
+pub(super) fn release(rows: &[Row], live: &[Row], bodies: &mut [Side], acc: &mut [Accumulated]) {
+    for rp in rows {
+        let gone = !live
+            .iter()
+            .any(|l| l.joint == rp.joint && l.held == rp.held);
+        let h = held(rp, acc);
+        if rp.held.one_sided() && gone && h != 0.0 {
+            push(rp, -h, bodies, acc);
         }
     }
 }

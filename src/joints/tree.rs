@@ -60,13 +60,17 @@ pub(super) struct TreeScratch {
     solution: Vec<f64>,
     queue: Vec<usize>,
     single: block::Dense,
+    /// The rows still held while the limits' active set is found.
+    live: Vec<Row>,
 }
 
 const NONE: usize = usize::MAX;
 
 /// Solves `rows` (whole joints, each joint's rows together) against `bodies` in `mode` and
 /// applies the impulses, as [`block::solve`] does but in time linear in the rows when they
-/// form a tree; a joint that closes a loop is solved after the tree, on its own.
+/// form a tree; a joint that closes a loop is solved after the tree, on its own. The limits'
+/// one-sided rows are found by the same active set as there: any whose total would pull is
+/// let go and the tree solved again, each round in linear time.
 pub(super) fn solve(
     rows: &[Row],
     bodies: &mut [Side],
@@ -77,13 +81,24 @@ pub(super) fn solve(
     if rows.is_empty() {
         return;
     }
-    let loops = build(rows, bodies, s);
-    factor_and_solve(rows, bodies, mode, s);
-    block::apply(rows, &s.solution, bodies, acc, mode);
+    let mut live = std::mem::take(&mut s.live);
+    live.clear();
+    live.extend_from_slice(rows);
+    // Each round lets go of at least one row, so this ends.
+    let loops = loop {
+        let loops = build(&live, bodies, s);
+        factor_and_solve(&live, bodies, mode, s);
+        if !block::let_go_pulling(&mut live, &s.solution, acc, mode) {
+            break loops;
+        }
+        block::release(rows, &live, bodies, acc);
+    };
+    block::apply(&live, &s.solution, bodies, acc, mode);
     // Joints closing a loop, each on its own against what the tree left.
     for (first, end) in loops {
-        block::solve(&rows[first..end], bodies, acc, mode, &mut s.single);
+        block::solve(&live[first..end], bodies, acc, mode, &mut s.single);
     }
+    s.live = live;
 }
 
 /// Lays out the tree's nodes in breadth-first order from each body not yet reached; returns
@@ -466,6 +481,13 @@ mod tests {
     /// one to the world, 26 rows. Optionally a sixth joint from the forearm back to the
     /// torso, which closes a loop.
     fn ragdoll(with_loop: bool) -> (Vec<Side>, Vec<Row>) {
+        ragdoll_with(with_loop, None)
+    }
+
+    /// [`ragdoll`], its left arm's ball joint twisting 0.1..0.2 rad about x (past its lower
+    /// stop) and its forearm's hinge turning ±0.3 rad, their limits' rows included with
+    /// `limits`' impulses.
+    fn ragdoll_with(with_loop: bool, limits: Option<&[Accumulated]>) -> (Vec<Side>, Vec<Row>) {
         let sides = vec![
             Side::WORLD,
             body(Vec3A::ZERO, 0.1, Vec3A::new(0.2, 0.0, 0.1)),
@@ -526,9 +548,74 @@ mod tests {
         };
         for (j, (a, b, geometry)) in joints.iter().take(count).enumerate() {
             let side = |i: usize| ((i > 0).then_some(i), &sides[i]);
-            block::joint_rows(j, geometry, side(*a), side(*b), None, &mut rows);
+            let mut geometry = *geometry;
+            if limits.is_some() && j == 2 {
+                geometry.axial.axis = Some(super::super::solve::Axis::Twist {
+                    axis_a: Vec3::X,
+                    axis_b: Vec3::X,
+                });
+                geometry.axial.limits = Some((0.1, 0.2));
+            }
+            if limits.is_some() && j == 4 {
+                geometry.axial.axis = Some(super::super::solve::Axis::Turn {
+                    axis_a: Vec3::Z,
+                    axis_b: Vec3::Z,
+                });
+                geometry.axial.limits = Some((-0.3, 0.3));
+            }
+            let held = limits.map(|acc| (1.0 / 240.0, &acc[j]));
+            block::joint_rows(j, &geometry, side(*a), side(*b), held, &mut rows);
         }
         (sides, rows)
+    }
+
+    /// Solves `rows` densely (into `acc`) and as a tree (into a copy, returned), and checks
+    /// that both leave the bodies with the same velocities.
+    fn both_ways(
+        rows: &[Row],
+        sides: &[Side],
+        acc: &mut [Accumulated],
+        mode: Mode,
+    ) -> Vec<Accumulated> {
+        let (mut dense, mut sparse) = (sides.to_vec(), sides.to_vec());
+        let mut acc_sparse = acc.to_vec();
+        block::solve(rows, &mut dense, acc, mode, &mut block::Dense::default());
+        solve(
+            rows,
+            &mut sparse,
+            &mut acc_sparse,
+            mode,
+            &mut TreeScratch::default(),
+        );
+        for (d, s) in dense.iter().zip(&sparse) {
+            assert!((d.v - s.v).length() < 1e-4, "{} against {}", s.v, d.v);
+            assert!((d.w - s.w).length() < 1e-4, "{} against {}", s.w, d.w);
+        }
+        acc_sparse
+    }
+
+    #[test]
+    fn a_tree_with_limits_finds_the_dense_systems_active_set() {
+        // The twist past its stop keeps pushing; the hinge, far from its stop, lets go of
+        // what it held: the tree finds the same active set as the dense system.
+        for (lower, upper) in [(0.5, 0.0), (0.0, 0.0), (2.0, 0.0)] {
+            let mut acc = vec![Accumulated::default(); 5];
+            acc[2].lower = lower;
+            acc[2].upper = upper;
+            acc[4].upper = 0.3;
+            let (sides, rows) = ragdoll_with(false, Some(&acc));
+            assert!(rows.iter().filter(|r| r.held.one_sided()).count() == 2);
+            let acc_sparse = both_ways(&rows, &sides, &mut acc, Mode::RIGID);
+            for (d, s) in acc.iter().zip(&acc_sparse) {
+                for (x, y) in [(d.lower, s.lower), (d.upper, s.upper)] {
+                    assert!(
+                        x >= 0.0 && (x - y).abs() < 1e-4 * (1.0 + x),
+                        "{x} against {y}"
+                    );
+                }
+            }
+            assert!(acc[2].lower > 0.0 && acc[4].upper == 0.0, "{acc:?}");
+        }
     }
 
     #[test]
@@ -543,7 +630,6 @@ mod tests {
                 impulse_scale: 0.2,
             },
         ] {
-            let (mut dense, mut sparse) = (sides.clone(), sides.clone());
             let mut acc = vec![
                 Accumulated {
                     linear: Vec3A::X,
@@ -551,25 +637,7 @@ mod tests {
                 };
                 5
             ];
-            let mut acc_sparse = acc.clone();
-            block::solve(
-                &rows,
-                &mut dense,
-                &mut acc,
-                mode,
-                &mut block::Dense::default(),
-            );
-            solve(
-                &rows,
-                &mut sparse,
-                &mut acc_sparse,
-                mode,
-                &mut TreeScratch::default(),
-            );
-            for (d, s) in dense.iter().zip(&sparse) {
-                assert!((d.v - s.v).length() < 1e-4, "{} against {}", s.v, d.v);
-                assert!((d.w - s.w).length() < 1e-4, "{} against {}", s.w, d.w);
-            }
+            let acc_sparse = both_ways(&rows, &sides, &mut acc, mode);
             for (d, s) in acc.iter().zip(&acc_sparse) {
                 assert!((d.linear - s.linear).length() < 1e-4 * (1.0 + d.linear.length()));
                 assert!((d.angular - s.angular).length() < 1e-4 * (1.0 + d.angular.length()));
