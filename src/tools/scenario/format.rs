@@ -276,6 +276,10 @@ pub enum JointKind {
         /// A motor: target speed (rad/s) and the most torque it gives (N·m).
         #[serde(default)]
         motor: Option<(f32, f32)>,
+        /// A position motor (servo): target angle (degrees), stiffness (N·m/rad), damping
+        /// (N·m·s/rad) and the most torque it gives (N·m). Takes the place of `motor`.
+        #[serde(default)]
+        servo: Option<(f32, f32, f32, f32)>,
     },
     /// A slider along `axis`, the relative rotation held as spawned.
     Slider {
@@ -287,6 +291,10 @@ pub enum JointKind {
         /// A motor: target speed (m/s) and the most force it gives (N).
         #[serde(default)]
         motor: Option<(f32, f32)>,
+        /// A position motor (servo): target offset (m), stiffness (N/m), damping (N·s/m)
+        /// and the most force it gives (N). Takes the place of `motor`.
+        #[serde(default)]
+        servo: Option<(f32, f32, f32, f32)>,
     },
     /// Keeps the anchors `length` apart (default: as spawned); `rope: true` lets them come
     /// closer.

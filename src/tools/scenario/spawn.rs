@@ -295,6 +295,7 @@ fn joint<'w>(world: &'w mut World, kind: &JointKind, sides: &Sides) -> Result<En
             axis,
             limits,
             motor,
+            servo,
         } => {
             let mut j = match a {
                 Some(a) => RevoluteJoint::new(a, b, axis),
@@ -306,12 +307,16 @@ fn joint<'w>(world: &'w mut World, kind: &JointKind, sides: &Sides) -> Result<En
             if let Some((speed, torque)) = motor {
                 j = j.with_motor(speed, torque);
             }
+            if let Some((target, stiffness, damping, torque)) = servo {
+                j = j.with_position_motor(target.to_radians(), stiffness, damping, torque);
+            }
             placed!(j)
         }
         JointKind::Slider {
             axis,
             limits,
             motor,
+            servo,
         } => {
             let mut j = match a {
                 Some(a) => PrismaticJoint::new(a, b, axis).with_relative(relative),
@@ -322,6 +327,9 @@ fn joint<'w>(world: &'w mut World, kind: &JointKind, sides: &Sides) -> Result<En
             }
             if let Some((speed, force)) = motor {
                 j = j.with_motor(speed, force);
+            }
+            if let Some((target, stiffness, damping, force)) = servo {
+                j = j.with_position_motor(target, stiffness, damping, force);
             }
             placed!(j)
         }

@@ -177,47 +177,60 @@ fn a_position_motor_swings_a_flywheel_to_its_angle_as_a_damped_spring() {
     // A servo on the flywheel (I = 52.36 kg·m²): stiffness k = I (2π)² (1 Hz), damping ratio
     // ζ = 0.1, towards 1 rad from rest at 0. Closed form: the first peak at π / ω_d
     // (ω_d = 2π √(1 − ζ²)) overshooting by exp(−ζ π / √(1 − ζ²)) = 72.9 %, then rest at 1 rad.
-    let (mut world, ball, joint, inertia) = flywheel(0.0, 0.0, 0.0);
-    let omega = std::f32::consts::TAU;
-    let (k, zeta) = (inertia * omega * omega, 0.1_f32);
-    let c = 2.0 * zeta * (k * inertia).sqrt();
-    world.get_mut::<RevoluteJoint>(joint).unwrap().motor = RevoluteJoint::to_world(ball, Vec3::Z)
-        .with_position_motor(1.0, k, c, 1e6)
-        .motor;
-    let dt = 1.0 / 60.0;
-    let (mut t, mut peak, mut peak_at) = (0.0_f32, 0.0_f32, 0.0_f32);
-    let (mut prev, mut falling) = (turn(&world, ball), false);
-    let damped = omega * (1.0 - zeta * zeta).sqrt();
-    let closed = |t: f32| {
-        let ratio = zeta / (1.0 - zeta * zeta).sqrt();
-        1.0 - (-zeta * omega * t).exp() * ((damped * t).cos() + ratio * (damped * t).sin())
-    };
-    let mut worst = 0.0_f32;
-    while t < 10.0 {
-        world.step_physics();
-        t += dt;
-        let theta = turn(&world, ball);
-        worst = worst.max((theta - closed(t)).abs());
-        if !falling && theta < prev {
-            falling = true;
-            (peak, peak_at) = (prev, t - dt);
+    // At the defaults (60 Hz × 4) and over frame rates and substeps.
+    for (dt, substeps) in [
+        (1.0 / 60.0, 4),
+        (1.0 / 60.0, 1),
+        (1.0 / 30.0, 4),
+        (1.0 / 144.0, 2),
+    ] {
+        let (mut world, ball, joint, inertia) = flywheel(0.0, 0.0, 0.0);
+        world.insert_resource(PhysicsTime::new(dt, substeps).unwrap());
+        let h = dt / substeps as f32;
+        let omega = std::f32::consts::TAU;
+        let (k, zeta) = (inertia * omega * omega, 0.1_f32);
+        let c = 2.0 * zeta * (k * inertia).sqrt();
+        world.get_mut::<RevoluteJoint>(joint).unwrap().motor =
+            RevoluteJoint::to_world(ball, Vec3::Z)
+                .with_position_motor(1.0, k, c, 1e6)
+                .motor;
+        let (mut t, mut peak, mut peak_at) = (0.0_f32, 0.0_f32, 0.0_f32);
+        let (mut prev, mut falling) = (turn(&world, ball), false);
+        let damped = omega * (1.0 - zeta * zeta).sqrt();
+        let closed = |t: f32| {
+            let ratio = zeta / (1.0 - zeta * zeta).sqrt();
+            1.0 - (-zeta * omega * t).exp() * ((damped * t).cos() + ratio * (damped * t).sin())
+        };
+        let mut worst = 0.0_f32;
+        while t < 10.0 {
+            world.step_physics();
+            t += dt;
+            let theta = turn(&world, ball);
+            worst = worst.max((theta - closed(t)).abs());
+            if !falling && theta < prev {
+                falling = true;
+                (peak, peak_at) = (prev, t - dt);
+            }
+            prev = theta;
         }
-        prev = theta;
+        let (closed_at, closed_peak) = (
+            std::f32::consts::PI / damped,
+            1.0 + (-zeta * std::f32::consts::PI / (1.0 - zeta * zeta).sqrt()).exp(),
+        );
+        println!(
+            "1/{:.0} s × {substeps}: first peak {peak:.4} rad at {peak_at:.4} s (closed form {closed_peak:.4} rad at {closed_at:.4} s); at 10 s {:.5} rad; off the closed form by at most {worst:.4} rad",
+            1.0 / dt,
+            turn(&world, ball)
+        );
+        assert!(
+            (peak_at - closed_at).abs() < 1.5 * dt,
+            "peak at {peak_at} s"
+        );
+        assert!((peak - closed_peak).abs() < 0.005, "peak {peak} rad");
+        // Mostly the substep's stagger, h / 2 ahead of the closed form's clock (4.6 rad/s × h/2).
+        assert!(
+            worst < 0.005 + 2.4 * h,
+            "off the closed form by {worst} rad"
+        );
     }
-    let (closed_at, closed_peak) = (
-        std::f32::consts::PI / damped,
-        1.0 + (-zeta * std::f32::consts::PI / (1.0 - zeta * zeta).sqrt()).exp(),
-    );
-    println!(
-        "first peak {peak:.4} rad at {peak_at:.4} s (closed form {closed_peak:.4} rad at {closed_at:.4} s); at 10 s {:.5} rad; off the closed form by at most {worst:.4} rad",
-        turn(&world, ball)
-    );
-    assert!(
-        (peak_at - closed_at).abs() < 1.5 * dt,
-        "peak at {peak_at} s"
-    );
-    assert!((peak - closed_peak).abs() < 0.005, "peak {peak} rad");
-    // Mostly the substep's stagger: positions move with the velocity at the end of each
-    // substep, h / 2 = 2 ms ahead of the closed form's clock (4.6 rad/s × 2 ms = 0.0096 rad).
-    assert!(worst < 0.015, "off the closed form by {worst} rad");
 }
