@@ -62,6 +62,9 @@ pub(super) struct TreeScratch {
     single: block::Dense,
     /// The rows still held while the limits' active set is found.
     live: Vec<Row>,
+    /// The sides whose adjacency `build` filled, and the bodies in row order.
+    touched: Vec<usize>,
+    roots: Vec<usize>,
 }
 
 const NONE: usize = usize::MAX;
@@ -111,7 +114,8 @@ fn build(rows: &[Row], bodies: &[Side], s: &mut TreeScratch) -> Vec<(usize, usiz
     s.links.clear();
     // Joint runs: consecutive rows of one joint.
     let mut first = 0;
-    let mut touched = Vec::new();
+    let mut touched = std::mem::take(&mut s.touched);
+    touched.clear();
     while first < rows.len() {
         let j = rows[first].joint;
         let end = first + rows[first..].iter().take_while(|r| r.joint == j).count();
@@ -145,9 +149,11 @@ fn build(rows: &[Row], bodies: &[Side], s: &mut TreeScratch) -> Vec<(usize, usiz
     s.place.clear();
     s.place.resize(rows.len(), (NONE, 0));
     // Bodies in row order, so that the roots (and the layout) follow the joints' order.
-    let mut roots: Vec<usize> = rows.iter().flat_map(|r| [r.a, r.b]).flatten().collect();
+    let mut roots = std::mem::take(&mut s.roots);
+    roots.clear();
+    roots.extend(rows.iter().flat_map(|r| [r.a, r.b]).flatten());
     roots.dedup();
-    for root in roots {
+    for &root in &roots {
         if s.node_of[root] != NONE {
             continue;
         }
@@ -189,9 +195,10 @@ fn build(rows: &[Row], bodies: &[Side], s: &mut TreeScratch) -> Vec<(usize, usiz
         .filter(|&k| !s.used[k])
         .map(|k| (s.links[k].0, s.links[k].1))
         .collect();
-    for side in touched {
+    for &side in &touched {
         s.adjacency[side].clear();
     }
+    (s.touched, s.roots) = (touched, roots);
     loops
 }
 
