@@ -15,9 +15,11 @@ use glam::Vec3A;
 
 use super::solve::{Accumulated, Angular, Linear, Mode, Rows, Side};
 
-/// Rows above which a group falls back to one joint after another: the dense solve costs
-/// rows³/3 per pass (96 rows: 0.3 M operations).
-pub(super) const MAX_GROUP_ROWS: usize = 96;
+/// Rows above which a group is solved as a tree (or joint after joint): the dense solve
+/// costs rows³/3 per pass (128 rows: 0.7 M operations). A bridge of 24 planks (125 rows),
+/// a loop through the ground, fits: solved densely, it rests exactly where its closed form
+/// says; as a tree it needs one of its ends solved after the rest.
+pub(super) const MAX_GROUP_ROWS: usize = 128;
 
 /// What a row's impulse adds to: the joint's linear or angular accumulator (a vector, along
 /// the row's direction), or one of its limits' (a one-sided row: its total stays ≥ 0).
@@ -428,9 +430,27 @@ pub(super) fn apply(
     }
 }
 
+/// The smallest pivot a row may leave after the rows before it and still count as
+/// independent of them, under the regularisation `eps` (1e-10 of the largest effective mass
+/// of the system's rows): 10⁴ eps.
+///
+/// A row that repeats what other rows hold (a loop of hinges with parallel axes locks its
+/// out-of-plane motion twice: a plank bridge hinged at both ends) leaves a pivot of about
+/// eps. Kept, any mismatch between the rows it repeats (f32 rounding) comes back as an
+/// impulse 1 / eps times larger, one that moves nothing but builds up in the warm start
+/// until its own rounding moves everything: a kicked bridge of 16 planks ran away at once,
+/// one of 20 to forces of meganewtons within seconds. Left out (its λ zero), the rows
+/// before it hold what it held. An independent row leaves a pivot of about its effective
+/// mass in what the rows before it left free; that falls to the floor only at mass ratios
+/// near 10⁶.
+pub(super) fn redundancy_floor(eps: f64) -> f64 {
+    1e4 * eps
+}
+
 /// Solves A x = b in place (`b` becomes x) for symmetric positive semi-definite A (n × n,
-/// row-major), by Cholesky with a small relative regularisation so that redundant rows (a
-/// loop of joints) do not stop it. False when A has no usable pivot.
+/// row-major), by Cholesky with a small relative regularisation; a row that no mass moves
+/// or that the rows before it already hold is left out (its x zero). False when A has no
+/// usable pivot.
 fn cholesky_solve(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
     let scale = (0..n).map(|i| a[i * n + i]).fold(0.0_f64, f64::max);
     if !(scale > 0.0 && scale.is_finite()) {
@@ -442,8 +462,9 @@ fn cholesky_solve(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
         for k in 0..j {
             d -= a[j * n + k] * a[j * n + k];
         }
-        if d.is_nan() || d <= 0.0 {
-            // A row with no mass behind it (both sides immovable): leave it out.
+        if d.is_nan() || d <= redundancy_floor(eps) {
+            // A row with no mass behind it (both sides immovable), or one the rows before it
+            // already hold (see `redundancy_floor`): leave it out.
             a[j * n + j] = f64::INFINITY;
             for i in j + 1..n {
                 a[i * n + j] = 0.0;

@@ -31,7 +31,7 @@
 //! [`JointSettings::damping_ratio`] would (Box2D v3's soft step), then, after the positions
 //! move, one pass without bias removes the anchors' relative velocity. The relax pass is
 //! rigid, so the soft bias adds no energy to the motion it leaves. Joints connected through
-//! moving bodies are solved as one system (dense up to 96 rows, a tree in linear time past
+//! moving bodies are solved as one system (dense up to 128 rows, a tree in linear time past
 //! that; a net of loops joint after joint), and each pass turns a jointed body with its
 //! inertia stiffened by its joints' pull (see `solve.rs`), which keeps light links under
 //! heavy loads in line. [`JointDiagnostics`] reports how well the joints hold.

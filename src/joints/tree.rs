@@ -38,6 +38,8 @@ struct Node {
     coupling: usize,
     reduced: usize,
     rhs: usize,
+    /// Offset in `floors`.
+    floor: usize,
 }
 
 /// Working memory kept between passes.
@@ -58,6 +60,9 @@ pub(super) struct TreeScratch {
     /// Per row: the node holding its λ and the place within the node.
     place: Vec<(usize, usize)>,
     solution: Vec<f64>,
+    /// Per unknown of each node (at its `pivot`'s node order): the smallest pivot a λ row
+    /// may leave and still count as independent of the rows before it (0 for a body's).
+    floors: Vec<f64>,
     queue: Vec<usize>,
     single: block::Dense,
     /// The rows still held while the limits' active set is found.
@@ -65,6 +70,8 @@ pub(super) struct TreeScratch {
     /// The sides whose adjacency `build` filled, and the bodies in row order.
     touched: Vec<usize>,
     roots: Vec<usize>,
+    /// The world joints left out of the tree (a second tie to the ground closes a loop).
+    grounding: Vec<(usize, usize)>,
 }
 
 const NONE: usize = usize::MAX;
@@ -145,6 +152,7 @@ fn build(rows: &[Row], bodies: &[Side], s: &mut TreeScratch) -> Vec<(usize, usiz
     }
     s.used.clear();
     s.used.resize(s.links.len(), false);
+    s.grounding.clear();
     s.nodes.clear();
     s.place.clear();
     s.place.resize(rows.len(), (NONE, 0));
@@ -157,7 +165,12 @@ fn build(rows: &[Row], bodies: &[Side], s: &mut TreeScratch) -> Vec<(usize, usiz
         if s.node_of[root] != NONE {
             continue;
         }
-        push_body(s, root, None);
+        // One tie to the ground per tree: a second one (a bridge hinged at both ends)
+        // closes a loop through the ground, solved after the tree like any other. Inside
+        // the tree it would lock some motions twice (hinges with parallel axes lock the
+        // bridge's out-of-plane motion at both ends), and the bodies' reduced masses along
+        // those motions grow to 1 / E, past what the elimination can carry in f64.
+        let mut grounded = push_body(s, root, None, true);
         s.queue.clear();
         s.queue.push(root);
         let mut head = 0;
@@ -182,11 +195,12 @@ fn build(rows: &[Row], bodies: &[Side], s: &mut TreeScratch) -> Vec<(usize, usiz
                     coupling: 0,
                     reduced: 0,
                     rhs: 0,
+                    floor: 0,
                 });
                 for (k, place) in s.place[first..end].iter_mut().enumerate() {
                     *place = (joint, k);
                 }
-                push_body(s, other, Some(joint));
+                grounded |= push_body(s, other, Some(joint), !grounded);
                 s.queue.push(other);
             }
         }
@@ -194,6 +208,7 @@ fn build(rows: &[Row], bodies: &[Side], s: &mut TreeScratch) -> Vec<(usize, usiz
     let loops = (0..s.links.len())
         .filter(|&k| !s.used[k])
         .map(|k| (s.links[k].0, s.links[k].1))
+        .chain(s.grounding.drain(..))
         .collect();
     for &side in &touched {
         s.adjacency[side].clear();
@@ -202,12 +217,18 @@ fn build(rows: &[Row], bodies: &[Side], s: &mut TreeScratch) -> Vec<(usize, usiz
     loops
 }
 
-fn push_body(s: &mut TreeScratch, side: usize, parent: Option<usize>) {
+/// Adds `side`'s body node under `parent`, with its joints to the world folded in when
+/// `ground`, else set aside in `s.grounding`; returns whether it has any.
+fn push_body(s: &mut TreeScratch, side: usize, parent: Option<usize>, ground: bool) -> bool {
     let node = s.nodes.len();
     s.node_of[side] = node;
     let (from, to) = s.runs[side];
     let mut dim = 6;
     for &(_, first, end) in &s.world_runs[from..to] {
+        if !ground {
+            s.grounding.push((first, end));
+            continue;
+        }
         for (k, place) in s.place[first..end].iter_mut().enumerate() {
             *place = (node, dim + k);
         }
@@ -222,7 +243,9 @@ fn push_body(s: &mut TreeScratch, side: usize, parent: Option<usize>) {
         coupling: 0,
         reduced: 0,
         rhs: 0,
+        floor: 0,
     });
+    to > from
 }
 
 /// A row's Jacobian on `side` as six numbers (linear, then angular), zero if it does not
@@ -273,22 +296,20 @@ fn mass(side: &Side) -> [[f64; 6]; 6] {
 
 /// Assembles, factors and solves the tree; leaves each row's λ in `s.solution`.
 fn factor_and_solve(rows: &[Row], bodies: &[Side], mode: Mode, s: &mut TreeScratch) {
-    // E: 1e-10 of the largest diagonal entry of A.
-    let scale = rows
-        .iter()
-        .map(|r| {
-            let part = |side: Option<usize>, lin: Vec3A, ang: Vec3A| {
-                side.map_or(0.0, |i| {
-                    let (dv, dw) = block::response(&bodies[i], lin, ang);
-                    lin.dot(dv) + ang.dot(dw)
-                })
-            };
-            f64::from(part(r.a, r.lin_a, r.ang_a) + part(r.b, r.lin_b, r.ang_b))
-        })
-        .fold(0.0_f64, f64::max);
+    // Each row's own effective mass J M⁻¹ Jᵀ; E: 1e-10 of the largest.
+    let own = |r: &Row| {
+        let part = |side: Option<usize>, lin: Vec3A, ang: Vec3A| {
+            side.map_or(0.0, |i| {
+                let (dv, dw) = block::response(&bodies[i], lin, ang);
+                lin.dot(dv) + ang.dot(dw)
+            })
+        };
+        f64::from(part(r.a, r.lin_a, r.ang_a) + part(r.b, r.lin_b, r.ang_b))
+    };
+    let scale = rows.iter().map(own).fold(0.0_f64, f64::max);
     let eps = 1e-10 * scale.max(f64::MIN_POSITIVE);
     // Arena layout.
-    let mut size = 0;
+    let (mut size, mut floors) = (0, 0);
     for i in 0..s.nodes.len() {
         let parent_dim = s.nodes[i].parent.map_or(0, |p| s.nodes[p].dim);
         let n = s.nodes[i].dim;
@@ -298,9 +319,13 @@ fn factor_and_solve(rows: &[Row], bodies: &[Side], mode: Mode, s: &mut TreeScrat
         node.reduced = node.coupling + n * parent_dim;
         node.rhs = node.reduced + n * parent_dim;
         size = node.rhs + n;
+        node.floor = floors;
+        floors += n;
     }
     s.arena.clear();
     s.arena.resize(size, 0.0);
+    s.floors.clear();
+    s.floors.resize(floors, 0.0);
     // The λ unknowns: −E on the diagonal, the right-hand side, and for a body's own rows
     // (its joints to immovable sides) their Jacobians on it.
     for (row, &(owner, at)) in rows.iter().zip(&s.place) {
@@ -312,6 +337,7 @@ fn factor_and_solve(rows: &[Row], bodies: &[Side], mode: Mode, s: &mut TreeScrat
         let arena = &mut s.arena;
         arena[node.pivot + at * n + at] = -eps;
         arena[node.rhs + at] = -block::target(row, bodies, mode);
+        s.floors[node.floor + at] = block::redundancy_floor(eps);
         if node.body {
             for (c, &v) in jacobian(row, node.item).iter().enumerate() {
                 arena[node.pivot + at * n + c] = v;
@@ -355,7 +381,7 @@ fn factor_and_solve(rows: &[Row], bodies: &[Side], mode: Mode, s: &mut TreeScrat
         let n = node.dim;
         let (head, tail) = s.arena.split_at_mut(node.coupling);
         let pivot = &mut head[node.pivot..];
-        ldl_factor(pivot, n);
+        ldl_factor(pivot, n, &s.floors[node.floor..node.floor + n]);
         let Some(p) = node.parent else { continue };
         let np = s.nodes[p].dim;
         let (coupling, rest) = tail.split_at_mut(n * np);
@@ -425,17 +451,34 @@ fn factor_and_solve(rows: &[Row], bodies: &[Side], mode: Mode, s: &mut TreeScrat
 
 /// Factors the symmetric n × n block `a` (row-major) in place as L D Lᵀ without pivoting:
 /// D on the diagonal, L below it. Quasi-definite blocks always factor this way.
-fn ldl_factor(a: &mut [f64], n: usize) {
+///
+/// A λ row whose pivot is within its `floor` of zero depends on the rows before it (a loop
+/// of hinges with parallel axes locks its out-of-plane motion twice): it is left out, its
+/// λ zero. Kept, its pivot would be −E, and any mismatch between the rows it repeats
+/// (rounding) would come back as an impulse 1 / E = 10¹⁰ times larger that moves nothing
+/// but builds up in the warm start until the rounding of it moves everything.
+fn ldl_factor(a: &mut [f64], n: usize, floor: &[f64]) {
     for j in 0..n {
         let mut d = a[j * n + j];
         for k in 0..j {
-            d -= a[j * n + k] * a[j * n + k] * a[k * n + k];
+            if a[k * n + k].is_finite() {
+                d -= a[j * n + k] * a[j * n + k] * a[k * n + k];
+            }
+        }
+        if floor[j] > 0.0 && (d.is_nan() || d.abs() <= floor[j]) {
+            a[j * n + j] = f64::NEG_INFINITY;
+            for i in j + 1..n {
+                a[i * n + j] = 0.0;
+            }
+            continue;
         }
         a[j * n + j] = d;
         for i in j + 1..n {
             let mut v = a[i * n + j];
             for k in 0..j {
-                v -= a[i * n + k] * a[j * n + k] * a[k * n + k];
+                if a[k * n + k].is_finite() {
+                    v -= a[i * n + k] * a[j * n + k] * a[k * n + k];
+                }
             }
             a[i * n + j] = v / d;
         }

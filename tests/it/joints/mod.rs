@@ -1,5 +1,6 @@
 //! Joints against closed forms, at the defaults.
 
+mod bridge;
 mod cones;
 mod hard_cases;
 mod kinematic_carriers;
