@@ -11,9 +11,11 @@ use crate::particles::{LinearVelocity, Position};
 use crate::rigid::RigidBody;
 
 mod bridge;
+mod door;
 mod ragdoll;
 
 pub use bridge::{ChainBridge, ChainBridgeParts};
+pub use door::{HingedDoor, HingedDoorParts};
 pub use ragdoll::{Ragdoll, RagdollJoint, RagdollPart, RagdollPile, RagdollTurn};
 
 /// A chain of `links` boxes of 0.1 × 0.2 × 0.1 m (2 kg at 1000 kg/m³) on ball joints,

@@ -2,6 +2,7 @@
 
 mod bridge;
 mod cones;
+mod door;
 mod hard_cases;
 mod kinematic_carriers;
 mod limits;
