@@ -14,35 +14,16 @@
 mod common;
 use common::{axes, legend, register_fonts};
 
-use std::path::PathBuf;
-
 use bevy_ecs::prelude::*;
 use glam::{Vec3, Vec3A};
 use hooke::prelude::*;
 use hooke::tools::joint_scenes::{ChainBridge, ChainBridgeParts};
 use plotters::prelude::*;
 
-struct Options {
-    seconds: f32,
-    out: PathBuf,
-}
+type Options = common::Clip;
 
 fn options() -> Result<Options, String> {
-    let mut o = Options {
-        seconds: 16.0,
-        out: PathBuf::from("out/bridge.gif"),
-    };
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let mut it = args.iter();
-    while let Some(flag) = it.next() {
-        let value = it.next().ok_or(format!("{flag} needs a value"))?;
-        match flag.as_str() {
-            "--seconds" => o.seconds = value.parse().map_err(|e| format!("--seconds: {e}"))?,
-            "--out" => o.out = PathBuf::from(value),
-            other => return Err(format!("unknown flag {other}")),
-        }
-    }
-    Ok(o)
+    common::clip_options(16.0, "out/bridge.gif")
 }
 
 /// The corners of box `e` (half extents `half`) seen from the side: (x, y) in m.

@@ -3,8 +3,8 @@
 //!
 //! - [`scenes`]: the scene builders shared by tests, examples, benchmarks and scenarios;
 //! - [`box3d`]: Box3D's benchmark scenes (large_pyramid, many_pyramids, convex_pile);
-//! - [`joint_scenes`]: jointed scenes (a chain hanging a load, ragdolls, a plank bridge), the
-//!   chain and the ragdolls built alike in hooke and rapier;
+//! - [`joint_scenes`]: jointed scenes (a chain hanging a load, ragdolls, a plank bridge, a
+//!   door, a car), the chain and the ragdolls built alike in hooke and rapier;
 //! - [`scenario`]: RON files that build a scene, act on it on a timeline and check
 //!   expectations (the `hooke` command runs them, with the `cli` feature);
 //! - [`accuracy`]: the accuracy sweep, error against closed forms for each setting of the dial;

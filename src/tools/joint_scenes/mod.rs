@@ -13,10 +13,12 @@ use crate::rigid::RigidBody;
 mod bridge;
 mod door;
 mod ragdoll;
+mod vehicle;
 
 pub use bridge::{ChainBridge, ChainBridgeParts};
 pub use door::{HingedDoor, HingedDoorParts};
 pub use ragdoll::{Ragdoll, RagdollJoint, RagdollPart, RagdollPile, RagdollTurn};
+pub use vehicle::{FourWheeler, FourWheelerParts};
 
 /// A chain of `links` boxes of 0.1 × 0.2 × 0.1 m (2 kg at 1000 kg/m³) on ball joints,
 /// hanging from the world point (0, 25, 0), an 8 kg box of 0.2 m at its end kicked sideways

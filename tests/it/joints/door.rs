@@ -2,41 +2,16 @@
 //! momentum gives it, the ball goes on (or bounces back) at the closed form's speed, and the
 //! door comes to rest at its open stop.
 
-use bevy_ecs::prelude::*;
 use hooke::prelude::*;
 use hooke::tools::joint_scenes::HingedDoor;
-use hooke::tools::scenes;
 
 use crate::common::default_world;
-
-/// A world's name and how to make it.
-type Setup = (&'static str, fn() -> World);
 
 #[test]
 fn a_door_hit_by_a_ball_swings_at_the_blows_angular_momentum_and_stops_at_its_stop() {
     // At the defaults and at 30 Hz × 4 and 120 Hz × 2; a ball that does not bounce and one
     // of restitution 0.5.
-    let settings: [Setup; 3] = [
-        ("defaults", default_world),
-        ("30 Hz x 4", || {
-            scenes::world_with(
-                1.0 / 30.0,
-                4,
-                Integrator::SymplecticEuler,
-                Vec3::new(0.0, -9.81, 0.0),
-            )
-            .unwrap()
-        }),
-        ("120 Hz x 2", || {
-            scenes::world_with(
-                1.0 / 120.0,
-                2,
-                Integrator::SymplecticEuler,
-                Vec3::new(0.0, -9.81, 0.0),
-            )
-            .unwrap()
-        }),
-    ];
+    let settings = super::frame_rates();
     for (name, make) in settings {
         for restitution in [0.0, 0.5] {
             let scene = HingedDoor {

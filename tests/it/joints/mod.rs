@@ -10,6 +10,29 @@ mod motors;
 mod pendulums;
 mod ragdolls;
 mod stops;
+mod vehicle;
+
+/// A world's name and how to make it.
+type Setup = (&'static str, fn() -> bevy_ecs::world::World);
+
+/// The defaults, and gravity at 30 Hz × 4 substeps and 120 Hz × 2: the frame rates and
+/// substeps a jointed scene is checked at besides the defaults.
+fn frame_rates() -> [Setup; 3] {
+    fn at(dt: f32, substeps: u32) -> bevy_ecs::world::World {
+        hooke::tools::scenes::world_with(
+            dt,
+            substeps,
+            hooke::prelude::Integrator::SymplecticEuler,
+            glam::Vec3::new(0.0, -9.81, 0.0),
+        )
+        .unwrap()
+    }
+    [
+        ("defaults", crate::common::default_world),
+        ("30 Hz x 4", || at(1.0 / 30.0, 4)),
+        ("120 Hz x 2", || at(1.0 / 120.0, 2)),
+    ]
+}
 
 /// Why the entity `e` is quarantined: its input error as text.
 fn quarantine_reason(world: &bevy_ecs::world::World, e: bevy_ecs::entity::Entity) -> String {
