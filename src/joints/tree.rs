@@ -161,6 +161,15 @@ fn build(rows: &[Row], bodies: &[Side], s: &mut TreeScratch) -> Vec<(usize, usiz
     roots.clear();
     roots.extend(rows.iter().flat_map(|r| [r.a, r.b]).flatten());
     roots.dedup();
+    // A body tied to the ground is its tree's root: eliminated last, its world rows see the
+    // whole tree's mass. Below the root, a tie to the ground would leave the joint above it
+    // only the turns that tie allows, its other rows with pivots of about E (a redundant
+    // row's size), and the elimination would need 1 / E to carry them up.
+    let grounded = |b: &usize| s.runs[*b].1 > s.runs[*b].0;
+    let ties = roots.iter().filter(|b| grounded(b)).count();
+    if ties > 0 {
+        roots.sort_by_key(|b| !grounded(b));
+    }
     for &root in &roots {
         if s.node_of[root] != NONE {
             continue;

@@ -250,3 +250,45 @@ fn a_hundred_link_chain_holding_a_load_stays_within_a_centimetre() {
     let peak = widest_parting(&mut world, &joints, &bodies, |_| ());
     assert!(peak < 0.01, "anchors parted {peak} m");
 }
+
+#[test]
+fn a_hundred_link_chain_spawned_from_its_load_up_holds_the_same() {
+    // The same chain with its joints spawned from the load up, the joint to the world last:
+    // the tree is rooted at the body tied to the ground whatever the order. Rooted at the
+    // load, the top link's joint saw only the turn the tie allows, its other rows pivots
+    // of the regularisation's size, which the redundancy check left out: the chain fell
+    // apart, 124 m.
+    let mut world = default_world();
+    let chain = hooke::tools::joint_scenes::HangingChain { links: 100 };
+    let bodies: Vec<Entity> = chain
+        .bodies()
+        .iter()
+        .map(|b| {
+            world
+                .spawn((
+                    RigidBody::Dynamic,
+                    Collider::cuboid(b.half.x, b.half.y, b.half.z).unwrap(),
+                    Position(b.position.into()),
+                ))
+                .id()
+        })
+        .collect();
+    world.get_mut::<LinearVelocity>(bodies[100]).unwrap().0 =
+        hooke::tools::joint_scenes::HangingChain::KICK.into();
+    let joints: Vec<Joined> = chain
+        .joints()
+        .into_iter()
+        .rev()
+        .map(|(a, b, anchor_a, anchor_b)| (a.map(|a| bodies[a]), bodies[b], anchor_a, anchor_b))
+        .collect();
+    for &(a, b, anchor_a, anchor_b) in &joints {
+        let joint = match a {
+            None => SphericalJoint::to_world(b),
+            Some(a) => SphericalJoint::new(a, b),
+        };
+        world.spawn(joint.with_anchors(anchor_a, anchor_b));
+    }
+    let peak = widest_parting(&mut world, &joints, &bodies, |_| ());
+    println!("reversed: anchors parted {peak} m");
+    assert!(peak < 0.01, "anchors parted {peak} m");
+}
