@@ -52,9 +52,13 @@ fn scene_line(scene: Scene, small: bool, runs: usize, steps: usize) {
     );
 }
 
-/// The suite at Box3D's full sizes (its debug sizes and a fifth of the steps in quick mode).
-pub fn box3d_suite(quick: bool) {
-    for scene in Scene::ALL {
+/// The suite at Box3D's full sizes (its debug sizes and a fifth of the steps in quick mode);
+/// only the scene named `only` when it is not empty (`--scene joint_grid`).
+pub fn box3d_suite(quick: bool, only: &str) {
+    for scene in Scene::ALL
+        .into_iter()
+        .filter(|s| only.is_empty() || s.name() == only)
+    {
         if quick {
             scene_line(scene, true, 3, scene.steps() / 5);
         } else {

@@ -413,7 +413,12 @@ fn main() {
         contacts::contact_scenes(&cfg, quick);
     }
     if run("box3d") {
-        box3d::box3d_suite(quick);
+        // `--scene large_pyramid|many_pyramids|convex_pile|joint_grid|washer` runs one.
+        let scene = std::env::args()
+            .skip_while(|a| a != "--scene")
+            .nth(1)
+            .unwrap_or_default();
+        box3d::box3d_suite(quick, &scene);
     }
     if run("joints") {
         joints::chain_vs_rapier(if quick { 3 } else { 5 }, if quick { 60 } else { 300 });

@@ -1,5 +1,6 @@
 //! Joint rows solved together: each joint's rows as one block, or a whole connected group of
-//! joints as one system.
+//! joints as one system ([`super::envelope`] factors it); what a row's solution does to its
+//! bodies and its joint.
 //!
 //! A row p holds its Jacobian on each side (linear and angular parts) and the row's position
 //! error. The coupled effective mass is A_pq = Σ_s J_p,s M_s⁻¹ J_q,sᵀ over the moving bodies s
@@ -14,12 +15,6 @@
 use glam::Vec3A;
 
 use super::solve::{Accumulated, Angular, Linear, Mode, Rows, Side};
-
-/// Rows above which a group is solved as a tree (or joint after joint): the dense solve
-/// costs rows³/3 per pass (128 rows: 0.7 M operations). A bridge of 24 planks (125 rows),
-/// a loop through the ground, fits: solved densely, it rests exactly where its closed form
-/// says; as a tree it needs one of its ends solved after the rest.
-pub(super) const MAX_GROUP_ROWS: usize = 128;
 
 /// What a row's impulse adds to: the joint's linear or angular accumulator (a vector, along
 /// the row's direction), or one of its limits' (a one-sided row: its total stays ≥ 0).
@@ -215,145 +210,18 @@ pub(super) fn response(side: &Side, lin: Vec3A, ang: Vec3A) -> (Vec3A, Vec3A) {
     (side.inv_m * lin, side.inv_i * ang)
 }
 
-/// The memory a dense solve reuses between calls: the system and the rows still held.
-#[derive(Debug, Default)]
-pub(super) struct Dense {
-    matrix: Vec<f64>,
-    live: Vec<Row>,
+/// Whether one-sided row `rp` would pull with the solution `x`: its held impulse plus its new
+/// λ below zero (the active set lets it go then).
+pub(super) fn pulls(rp: &Row, x: f64, acc: &[Accumulated], mode: Mode) -> bool {
+    rp.held.one_sided() && held(rp, acc) + lambda(rp, x, acc, mode) < 0.0
 }
 
-/// Solves `rows` as one system against `bodies` in `mode`, applies the impulses and adds
-/// them to the joints' accumulators `acc`. `scratch` is reused between calls.
-pub(super) fn solve(
-    rows: &[Row],
-    bodies: &mut [Side],
-    acc: &mut [Accumulated],
-    mode: Mode,
-    scratch: &mut Dense,
-) {
-    if rows.iter().any(|r| r.held.one_sided()) {
-        solve_with_limits(rows, bodies, acc, mode, scratch);
-    } else {
-        solve_equalities(rows, bodies, acc, mode, &mut scratch.matrix);
+/// Takes back the impulse one-sided row `rp` holds.
+pub(super) fn let_go(rp: &Row, bodies: &mut [Side], acc: &mut [Accumulated]) {
+    let h = held(rp, acc);
+    if h != 0.0 {
+        push(rp, -h, bodies, acc);
     }
-}
-
-/// The limits' rows are one-sided: solved with the rest as equalities, any whose total
-/// impulse would pull is let go (its held impulse taken back) and the rest solved again, so
-/// a hinge stopped at its limit stops about the hinge, not about its centre of mass.
-fn solve_with_limits(
-    rows: &[Row],
-    bodies: &mut [Side],
-    acc: &mut [Accumulated],
-    mode: Mode,
-    scratch: &mut Dense,
-) {
-    let Dense {
-        matrix: scratch,
-        live,
-    } = scratch;
-    live.clear();
-    live.extend_from_slice(rows);
-    // Each round lets go of at least one row, so this ends.
-    loop {
-        if !solve_system(live, bodies, mode, scratch) {
-            return;
-        }
-        let n = live.len();
-        let x = &scratch[n * n..];
-        if !let_go_pulling(live, x, acc, mode) {
-            apply(live, x, bodies, acc, mode);
-            return;
-        }
-        release(rows, live, bodies, acc);
-    }
-}
-
-/// Drops from `live` the one-sided rows whose total impulse would pull with the solution
-/// `x` (a row with a NaN solution, one the solve left out, stays); true if any was dropped.
-pub(super) fn let_go_pulling(
-    live: &mut Vec<Row>,
-    x: &[f64],
-    acc: &[Accumulated],
-    mode: Mode,
-) -> bool {
-    let mut let_go = false;
-    let mut k = 0;
-    live.retain(|rp| {
-        let i = k;
-        k += 1;
-        if rp.held.one_sided() && held(rp, acc) + lambda(rp, x[i], acc, mode) < 0.0 {
-            let_go = true;
-            false
-        } else {
-            true
-        }
-    });
-    let_go
-}
-
-/// Takes back the impulse held by each one-sided row of `rows` no longer in `live`.
-pub(super) fn release(rows: &[Row], live: &[Row], bodies: &mut [Side], acc: &mut [Accumulated]) {
-    for rp in rows {
-        let gone = !live
-            .iter()
-            .any(|l| l.joint == rp.joint && l.held == rp.held);
-        let h = held(rp, acc);
-        if rp.held.one_sided() && gone && h != 0.0 {
-            push(rp, -h, bodies, acc);
-        }
-    }
-}
-
-/// Solves `rows` as equalities and applies the impulses.
-fn solve_equalities(
-    rows: &[Row],
-    bodies: &mut [Side],
-    acc: &mut [Accumulated],
-    mode: Mode,
-    scratch: &mut Vec<f64>,
-) {
-    if solve_system(rows, bodies, mode, scratch) {
-        let n = rows.len();
-        apply(rows, &scratch[n * n..], bodies, acc, mode);
-    }
-}
-
-/// Builds A (the coupled effective mass) and b in `scratch` and solves A x = b: x is then
-/// `scratch[n²..]`. False when there is nothing to solve or A has no usable pivot (x is
-/// then zero).
-fn solve_system(rows: &[Row], bodies: &[Side], mode: Mode, scratch: &mut Vec<f64>) -> bool {
-    let n = rows.len();
-    scratch.clear();
-    if n == 0 {
-        return false;
-    }
-    scratch.resize(n * n + n, 0.0);
-    let (a, rhs) = scratch.split_at_mut(n * n);
-    let sides = |r: &Row| [(r.a, r.lin_a, r.ang_a), (r.b, r.lin_b, r.ang_b)];
-    for (p, rp) in rows.iter().enumerate() {
-        for (body, lin, ang) in sides(rp) {
-            let Some(s) = body else { continue };
-            let (dv, dw) = response(&bodies[s], lin, ang);
-            for (q, rq) in rows.iter().enumerate().skip(p) {
-                for (other, lq, aq) in sides(rq) {
-                    if other == Some(s) {
-                        let v = f64::from(lq.dot(dv) + aq.dot(dw));
-                        a[p * n + q] += v;
-                        if q != p {
-                            a[q * n + p] += v;
-                        }
-                    }
-                }
-            }
-        }
-        rhs[p] = target(rp, bodies, mode);
-    }
-    if cholesky_solve(a, rhs, n) {
-        return true;
-    }
-    rhs.fill(0.0);
-    false
 }
 
 /// The right-hand side of row `rp`: −S_m (Ċ + β C).
@@ -413,20 +281,18 @@ fn push(rp: &Row, lambda: f32, bodies: &mut [Side], acc: &mut [Accumulated]) {
     }
 }
 
-/// Applies the solution `x` of A x = b to the rows' bodies: λ = x − S_i (the row's share of
-/// the accumulated impulse), added to the joints' accumulators.
-pub(super) fn apply(
-    rows: &[Row],
-    x: &[f64],
+/// Applies row `rp`'s part `x` of the solution of A x = b: λ = x − S_i (the row's share of
+/// the accumulated impulse), added to its joint's accumulator.
+pub(super) fn apply_one(
+    rp: &Row,
+    x: f64,
     bodies: &mut [Side],
     acc: &mut [Accumulated],
     mode: Mode,
 ) {
-    for (rp, &x) in rows.iter().zip(x.iter()) {
-        let lambda = lambda(rp, x, acc, mode);
-        if lambda.is_finite() {
-            push(rp, lambda, bodies, acc);
-        }
+    let lambda = lambda(rp, x, acc, mode);
+    if lambda.is_finite() {
+        push(rp, lambda, bodies, acc);
     }
 }
 
@@ -447,61 +313,11 @@ pub(super) fn redundancy_floor(eps: f64) -> f64 {
     1e4 * eps
 }
 
-/// Solves A x = b in place (`b` becomes x) for symmetric positive semi-definite A (n × n,
-/// row-major), by Cholesky with a small relative regularisation; a row that no mass moves
-/// or that the rows before it already hold is left out (its x zero). False when A has no
-/// usable pivot.
-fn cholesky_solve(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
-    let scale = (0..n).map(|i| a[i * n + i]).fold(0.0_f64, f64::max);
-    if !(scale > 0.0 && scale.is_finite()) {
-        return false;
-    }
-    let eps = 1e-10 * scale;
-    for j in 0..n {
-        let mut d = a[j * n + j] + eps;
-        for k in 0..j {
-            d -= a[j * n + k] * a[j * n + k];
-        }
-        if d.is_nan() || d <= redundancy_floor(eps) {
-            // A row with no mass behind it (both sides immovable), or one the rows before it
-            // already hold (see `redundancy_floor`): leave it out.
-            a[j * n + j] = f64::INFINITY;
-            for i in j + 1..n {
-                a[i * n + j] = 0.0;
-            }
-            continue;
-        }
-        let d = d.sqrt();
-        a[j * n + j] = d;
-        for i in j + 1..n {
-            let mut s = a[i * n + j];
-            for k in 0..j {
-                s -= a[i * n + k] * a[j * n + k];
-            }
-            a[i * n + j] = s / d;
-        }
-    }
-    for i in 0..n {
-        let mut s = b[i];
-        for k in 0..i {
-            s -= a[i * n + k] * b[k];
-        }
-        b[i] = s / a[i * n + i];
-    }
-    for i in (0..n).rev() {
-        let mut s = b[i];
-        for k in i + 1..n {
-            s -= a[k * n + i] * b[k];
-        }
-        b[i] = s / a[i * n + i];
-    }
-    b.iter().all(|x| x.is_finite())
-}
-
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use glam::{Mat3A, Vec3};
 
+    use super::super::envelope::{Envelope, solve};
     use super::*;
 
     fn body(x: Vec3A) -> Side {
@@ -514,7 +330,8 @@ mod tests {
         }
     }
 
-    fn relative_speed(rows: &[Row], sides: &[Side]) -> f32 {
+    /// The largest relative speed any of `rows` leaves between its bodies.
+    pub(in crate::joints) fn relative_speed(rows: &[Row], sides: &[Side]) -> f32 {
         let speed = |body: Option<usize>, lin: Vec3A, ang: Vec3A| {
             body.map_or(0.0, |s| lin.dot(sides[s].v) + ang.dot(sides[s].w))
         };
@@ -553,7 +370,7 @@ mod tests {
             &mut sides,
             &mut acc,
             Mode::RIGID,
-            &mut Dense::default(),
+            &mut Envelope::default(),
         );
         assert!(relative_speed(&rows, &sides) < 1e-5);
         let after: Vec3A = sides.iter().map(|s| s.v).sum();
@@ -594,7 +411,7 @@ mod tests {
             &mut dense,
             &mut acc_dense,
             mode,
-            &mut Dense::default(),
+            &mut Envelope::default(),
         );
         let mut acc = start;
         let [a, b] = sides.get_disjoint_mut([0, 1]).unwrap();
@@ -631,7 +448,7 @@ mod tests {
             &mut sides,
             &mut acc,
             Mode::RIGID,
-            &mut Dense::default(),
+            &mut Envelope::default(),
         );
         assert!(
             (sides[1].w - Vec3A::new(0.0, 0.0, 3.0)).length() < 1e-5,

@@ -69,10 +69,11 @@ mod axial;
 mod block;
 mod breaking;
 mod diagnostics;
+mod envelope;
+mod graph;
 mod kinds;
 mod plugin;
 mod solve;
-mod tree;
 
 pub use breaking::{JointBreakForce, JointBroken};
 pub use diagnostics::JointDiagnostics;

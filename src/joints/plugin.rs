@@ -8,9 +8,10 @@ use bevy_platform::collections::HashMap;
 
 use super::axial;
 use super::block::{self, Row};
+use super::envelope::{self, Envelope};
+use super::graph::{self, Forest, Ordering};
 use super::kinds::{self, Kinds};
 use super::solve::{self, Accumulated, Angular, Linear, Mode, Rows, Side};
-use super::tree::{self, TreeScratch};
 use super::{
     DistanceJoint, FixedJoint, JointImpulse, JointSettings, PrismaticJoint, RevoluteJoint,
     SphericalJoint,
@@ -218,15 +219,18 @@ struct Scratch {
     /// Per joint, its group's root; then the joints in group order.
     order: Vec<(usize, usize)>,
     rows: Vec<Row>,
-    matrix: block::Dense,
+    system: Envelope,
+    ordering: Ordering,
+    forest: Forest,
+    /// A group's joints while it is planned, and where its trees end.
+    group: Vec<usize>,
+    tree_ends: Vec<usize>,
     /// Per group root, its first joint (groups are solved in that order).
     first: HashMap<usize, usize>,
     /// The groups: their span in `order` and how each is solved.
     groups: Vec<(usize, usize, GroupSolve)>,
-    /// Per side: counted in [`mostly_tree`].
-    seen: Vec<bool>,
-    /// The tree solve's memory, for groups too large for one dense block.
-    tree: TreeScratch,
+    /// Per joint, what the plan was made for (see [`topology_changed`]).
+    topology: Vec<(usize, usize, usize)>,
     /// Per side, the geometric stiffness of its joints' pull (N·m per rad).
     stiffness: Vec<Mat3A>,
 }
@@ -259,8 +263,8 @@ fn place(s: &mut Scratch, bodies: &Bodies, e: Option<Entity>, anchor: Vec3) -> (
 }
 
 /// One pass over every joint: the warm start first when `warm`; then each group of joints
-/// connected through moving bodies is solved as one system (up to
-/// [`block::MAX_GROUP_ROWS`] rows), or joint after joint when larger.
+/// connected through moving bodies is solved as one system (when
+/// [`graph::affordable`]), or joint after joint (a net).
 fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32, s: &mut Scratch) {
     s.sides.clear();
     s.coms.clear();
@@ -303,13 +307,93 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     }
     stiffen_sides(s, joints, h);
     if warm {
-        for (j, &(rows, ia, ib)) in s.joints.iter().enumerate() {
+        for (j, (rows, ia, ib)) in s.joints.iter().enumerate() {
+            let (ia, ib) = (*ia, *ib);
             if let Ok([a, b]) = s.sides.get_disjoint_mut([ia, ib]) {
-                solve::warm_start(&rows, &mut s.acc[j], a, b);
-                axial::warm_start(&rows, &s.acc[j], a, b);
+                solve::warm_start(rows, &mut s.acc[j], a, b);
+                axial::warm_start(rows, &s.acc[j], a, b);
             }
         }
     }
+    if topology_changed(s) {
+        plan(s);
+    }
+    // Motors (and the limits no group takes) first, each on its own (Box2D's order): the
+    // rows after them keep what they leave free, the free axis.
+    free_axes(s, mode, h, warm);
+    for g in 0..s.groups.len() {
+        let (k, end, how) = s.groups[g];
+        if how == GroupSolve::Whole {
+            s.rows.clear();
+            for i in k..end {
+                let j = s.order[i].1;
+                push_rows(s, j, h);
+            }
+            envelope::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.system);
+        } else {
+            // A mesh of loops (a net, a grid): the tree would leave most joints to be solved
+            // after it anyway, so each joint is solved on its own, as Box2D solves them.
+            for i in k..end {
+                let (rows, ia, ib) = &s.joints[s.order[i].1];
+                let (ia, ib) = (*ia, *ib);
+                let j = s.order[i].1;
+                if let (Angular::Free, Linear::Point, Ok([a, b])) = (
+                    rows.angular,
+                    rows.linear,
+                    s.sides.get_disjoint_mut([ia, ib]),
+                ) {
+                    solve::solve_ball(rows, a, b, &mut s.acc[j], mode);
+                    continue;
+                }
+                s.rows.clear();
+                push_rows(s, j, h);
+                envelope::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.system);
+            }
+        }
+    }
+    for (side, &e) in s.sides.iter().zip(&s.entities) {
+        store(bodies, e, side);
+    }
+    for (((_, mut impulse), acc), (rows, ia, ib)) in joints.iter_mut().zip(&s.acc).zip(&s.joints) {
+        let (ia, ib) = (*ia, *ib);
+        // Bookkeeping, not a change anyone listens for.
+        let impulse = impulse.bypass_change_detection();
+        impulse.linear = acc.linear.into();
+        impulse.angular = acc.angular.into();
+        impulse.motor = acc.motor;
+        impulse.lower = acc.lower;
+        impulse.upper = acc.upper;
+        impulse.swing = acc.swing;
+        impulse.friction = acc.friction.into();
+        (impulse.axial_linear, impulse.axial_angular) =
+            axial::world_impulse(rows, acc, &s.sides[ia], &s.sides[ib]);
+        impulse.h = h;
+    }
+}
+
+/// Whether the joints' graph differs from the one the plan was made for: its joints, their
+/// sides' places, which of them move, and the rows each joint locks.
+fn topology_changed(s: &mut Scratch) -> bool {
+    let key = |&(rows, ia, ib): &(Rows, usize, usize)| {
+        let rod = rows.axial.limits.is_some_and(|(min, max)| min >= max);
+        let flags = usize::from(s.sides[ia].moves)
+            | usize::from(s.sides[ib].moves) << 1
+            | usize::from(rod) << 2
+            | rows.count() << 3;
+        (ia, ib, flags)
+    };
+    if s.topology.len() == s.joints.len() && s.joints.iter().map(key).eq(s.topology.iter().copied())
+    {
+        return false;
+    }
+    let topology: Vec<_> = s.joints.iter().map(key).collect();
+    s.topology = topology;
+    true
+}
+
+/// Plans the groups: bodies joined through moving bodies (an immovable side joins nothing),
+/// each solved as [`plan_group`] decides, and which joints' limits their group takes.
+fn plan(s: &mut Scratch) {
     // Groups: bodies joined through moving bodies (an immovable side joins nothing).
     s.parent.clear();
     s.parent.extend(0..s.sides.len());
@@ -338,15 +422,17 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     s.order.sort_unstable();
     // A group solved as one system takes its joints' limits with its other rows (a door
     // stopped at its limit stops about its hinge); elsewhere they are solved on their own.
-    s.in_block.clear();
-    s.in_block.resize(s.joints.len(), false);
     s.groups.clear();
     let mut k = 0;
     while k < s.order.len() {
         let end = group_end(s, k);
-        let how = how_to_solve(s, k, end);
-        s.groups.push((k, end, how));
-        if how != GroupSolve::JointByJoint {
+        plan_group(s, k, end);
+        k = end;
+    }
+    s.in_block.clear();
+    s.in_block.resize(s.joints.len(), false);
+    for &(k, end, how) in &s.groups {
+        if how == GroupSolve::Whole {
             for i in k..end {
                 let j = s.order[i].1;
                 // A rod (min = max) keeps its two-sided pair of rows apart: as rows of one
@@ -358,60 +444,6 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
                     .is_none_or(|(min, max)| min < max);
             }
         }
-        k = end;
-    }
-    // Motors (and the limits no group takes) first, each on its own (Box2D's order): the
-    // rows after them keep what they leave free, the free axis.
-    free_axes(s, mode, h, warm);
-    for g in 0..s.groups.len() {
-        let (k, end, how) = s.groups[g];
-        if how != GroupSolve::JointByJoint {
-            s.rows.clear();
-            for i in k..end {
-                let j = s.order[i].1;
-                push_rows(s, j, h);
-            }
-            if how == GroupSolve::Dense {
-                block::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.matrix);
-            } else {
-                tree::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.tree);
-            }
-        } else {
-            // A mesh of loops (a net, a grid): the tree would leave most joints to be solved
-            // after it anyway, so each joint is solved on its own, as Box2D solves them.
-            for i in k..end {
-                let (rows, ia, ib) = s.joints[s.order[i].1];
-                let j = s.order[i].1;
-                if let (Angular::Free, Linear::Point, Ok([a, b])) = (
-                    rows.angular,
-                    rows.linear,
-                    s.sides.get_disjoint_mut([ia, ib]),
-                ) {
-                    solve::solve_ball(&rows, a, b, &mut s.acc[j], mode);
-                    continue;
-                }
-                s.rows.clear();
-                push_rows(s, j, h);
-                block::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.matrix);
-            }
-        }
-    }
-    for (side, &e) in s.sides.iter().zip(&s.entities) {
-        store(bodies, e, side);
-    }
-    for (((_, mut impulse), acc), &(rows, ia, ib)) in joints.iter_mut().zip(&s.acc).zip(&s.joints) {
-        // Bookkeeping, not a change anyone listens for.
-        let impulse = impulse.bypass_change_detection();
-        impulse.linear = acc.linear.into();
-        impulse.angular = acc.angular.into();
-        impulse.motor = acc.motor;
-        impulse.lower = acc.lower;
-        impulse.upper = acc.upper;
-        impulse.swing = acc.swing;
-        impulse.friction = acc.friction.into();
-        (impulse.axial_linear, impulse.axial_angular) =
-            axial::world_impulse(&rows, acc, &s.sides[ia], &s.sides[ib]);
-        impulse.h = h;
     }
 }
 
@@ -421,7 +453,8 @@ fn stiffen_sides(s: &mut Scratch, joints: &Joints, h: f32) {
     s.stiffness.clear();
     s.stiffness.resize(s.sides.len(), Mat3A::ZERO);
     let mut any = false;
-    for ((&(rows, ia, ib), acc), (_, impulse)) in s.joints.iter().zip(&s.acc).zip(joints.iter()) {
+    for ((&(ref rows, ia, ib), acc), (_, impulse)) in s.joints.iter().zip(&s.acc).zip(joints.iter())
+    {
         if impulse.h.is_nan() || impulse.h <= 0.0 {
             continue;
         }
@@ -447,13 +480,14 @@ fn stiffen_sides(s: &mut Scratch, joints: &Joints, h: f32) {
 /// Solves every free axis's motor, and its limits unless its group takes them, each joint
 /// on its own.
 fn free_axes(s: &mut Scratch, mode: Mode, h: f32, first: bool) {
-    for (j, &(rows, ia, ib)) in s.joints.iter().enumerate() {
+    for (j, (rows, ia, ib)) in s.joints.iter().enumerate() {
+        let (ia, ib) = (*ia, *ib);
         if rows.axial.active()
             && let Ok(sides) = s.sides.get_disjoint_mut([ia, ib])
         {
             let [a, b] = sides;
             axial::solve(
-                &rows,
+                rows,
                 (a, b),
                 &mut s.acc[j],
                 (mode, h, first),
@@ -463,30 +497,58 @@ fn free_axes(s: &mut Scratch, mode: Mode, h: f32, first: bool) {
     }
 }
 
-/// How a group of joints is solved.
+/// How a run of joints is solved.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum GroupSolve {
-    /// As one dense system.
-    Dense,
-    /// As one system in the shape of its tree ([`tree::solve`]), the joints closing its few
-    /// loops each on its own after it.
-    Tree,
-    /// Joint after joint (a net of loops too large for one dense system).
+    /// As one system ([`envelope::solve`]), its joints in the order that keeps the
+    /// factorisation sparse.
+    Whole,
+    /// Joint after joint (the loops of a net of joints).
     JointByJoint,
 }
 
-/// How the group `s.order[k..end]` is solved: densely while it fits, as a tree in linear
-/// time past that if it is one but for a few loops (a long chain, a bridge), joint after
-/// joint otherwise. (Solved as a tree, a ragdoll of 38 rows took 15 % less time than
-/// densely, no more: the tree's per-body blocks of six cost as much as the dense rows.)
-fn how_to_solve(s: &mut Scratch, k: usize, end: usize) -> GroupSolve {
-    if group_rows(s, k, end) <= block::MAX_GROUP_ROWS {
-        GroupSolve::Dense
-    } else if mostly_tree(s, k, end) {
-        GroupSolve::Tree
+/// Plans how the group `s.order[k..end]` is solved and puts its joints in that order: as one
+/// system when that is [`graph::affordable`], else as the trees of
+/// [`graph::split_forest`] (each as one system when affordable) and then its loops' joints
+/// one after another.
+fn plan_group(s: &mut Scratch, k: usize, end: usize) {
+    let mut group = std::mem::take(&mut s.group);
+    group.clear();
+    group.extend(s.order[k..end].iter().map(|o| o.1));
+    let sides = &s.sides;
+    let joints = &s.joints;
+    let ends = |j: usize| {
+        let (_, ia, ib) = joints[j];
+        (sides[ia].moves.then_some(ia), sides[ib].moves.then_some(ib))
+    };
+    let rows = |j: usize| joints[j].0.count();
+    let plan = |span: &mut [usize], from: usize, groups: &mut Vec<_>, o: &mut _| {
+        let cost = graph::order_joints(span, ends, rows, o);
+        let how = if graph::affordable(cost, span.iter().map(|&j| rows(j)).sum()) {
+            GroupSolve::Whole
+        } else {
+            GroupSolve::JointByJoint
+        };
+        groups.push((k + from, k + from + span.len(), how));
+    };
+    let cost = graph::order_joints(&mut group, ends, rows, &mut s.ordering);
+    if graph::affordable(cost, group.iter().map(|&j| rows(j)).sum()) {
+        s.groups.push((k, end, GroupSolve::Whole));
     } else {
-        GroupSolve::JointByJoint
+        graph::split_forest(&mut group, ends, &mut s.forest, &mut s.tree_ends);
+        let mut from = 0;
+        for &to in &s.tree_ends {
+            plan(&mut group[from..to], from, &mut s.groups, &mut s.ordering);
+            from = to;
+        }
+        if from < group.len() {
+            s.groups.push((k + from, end, GroupSolve::JointByJoint));
+        }
     }
+    for (o, &j) in s.order[k..end].iter_mut().zip(&group) {
+        o.1 = j;
+    }
+    s.group = group;
 }
 
 /// The end of the group that starts at `s.order[k]`.
@@ -495,45 +557,16 @@ fn group_end(s: &Scratch, k: usize) -> usize {
     k + s.order[k..].iter().take_while(|o| o.0 == group).count()
 }
 
-/// The locked rows of the group `s.order[k..end]`.
-fn group_rows(s: &Scratch, k: usize, end: usize) -> usize {
-    s.order[k..end]
-        .iter()
-        .map(|&(_, j)| s.joints[j].0.count())
-        .sum()
-}
-
-/// Whether the group of joints `s.order[k..end]` is a tree but for a few loops: fewer than
-/// one joint in ten closes one (a chain, a ragdoll, a bridge; not a net). A connected group
-/// of B bodies and L joints between two of them has L − B + 1 loops.
-fn mostly_tree(s: &mut Scratch, k: usize, end: usize) -> bool {
-    s.seen.clear();
-    s.seen.resize(s.sides.len(), false);
-    let (mut bodies, mut links) = (0_usize, 0_usize);
-    for &(_, j) in &s.order[k..end] {
-        let (_, ia, ib) = s.joints[j];
-        let (ma, mb) = (s.sides[ia].moves, s.sides[ib].moves);
-        links += usize::from(ma && mb);
-        for (i, moves) in [(ia, ma), (ib, mb)] {
-            if moves && !s.seen[i] {
-                s.seen[i] = true;
-                bodies += 1;
-            }
-        }
-    }
-    let loops = (links + 1).saturating_sub(bodies);
-    loops * 10 < end - k
-}
-
 /// Appends joint `j`'s rows to `s.rows`, each side named only if it moves; its limits'
 /// rows too when its group is solved as one system.
 fn push_rows(s: &mut Scratch, j: usize, h: f32) {
-    let (rows, ia, ib) = s.joints[j];
+    let (rows, ia, ib) = &s.joints[j];
+    let (ia, ib) = (*ia, *ib);
     let moving = |i: usize| s.sides[i].moves.then_some(i);
     let limits = s.in_block[j].then_some((h, &s.acc[j]));
     block::joint_rows(
         j,
-        &rows,
+        rows,
         (moving(ia), &s.sides[ia]),
         (moving(ib), &s.sides[ib]),
         limits,

@@ -188,9 +188,10 @@ fn box3ds_washer_keeps_its_cubes_in_the_turning_drum() {
 #[test]
 fn box3ds_joint_grid_hangs_with_its_joints_held_as_in_rapier() {
     // Box3D's joint_grid at its full size (10,000 spheres, 19,800 ball joints, the top row
-    // static) for its 100 steps, side by side with rapier 0.36. A net of loops, solved one
-    // joint after another as Box3D and rapier solve it. Measured widest gap over the steps:
-    // hooke 24.9 mm, rapier 62.9 mm (the goal, 10 mm, is not met).
+    // static) for its 100 steps, side by side with rapier 0.36. A net of loops: hooke
+    // solves each column hanging from the top row as one system and the joints across them
+    // one after another. Measured widest gap over the steps: hooke 0.07 mm, rapier 62.9 mm
+    // (solved joint after joint, hooke's was 24.9 mm).
     let scene = Scene::JointGrid;
     let (mut world, bodies) = box3d::build(scene, false).unwrap();
     let (mut r, _) = rapier_box3d::rapier_scene(scene, &scene.bodies(false));
@@ -212,7 +213,7 @@ fn box3ds_joint_grid_hangs_with_its_joints_held_as_in_rapier() {
         assert!(world.get::<Quarantined>(e).is_none());
     }
     assert!(
-        ours <= theirs,
+        ours < 0.01 && ours <= theirs,
         "hooke's joints parted by {ours} m, rapier's by {theirs} m"
     );
 }
