@@ -89,7 +89,7 @@ impl WorldPlugin for JointPlugin {
     }
 }
 
-type JointItem<'a> = (Kinds<'a>, &'a mut JointImpulse);
+type JointItem<'a> = (Entity, Kinds<'a>, &'a mut JointImpulse);
 
 type BodyItem<'a> = (
     &'a Position,
@@ -229,6 +229,14 @@ struct Scratch {
     first: HashMap<usize, usize>,
     /// The groups: their span in `order` and how each is solved.
     groups: Vec<(usize, usize, GroupSolve)>,
+    /// The joints' entities in the order the query visited them, this pass and when the
+    /// order was last worked out, and per place in that order its joint's slot (the joints
+    /// are solved in the order of their entities).
+    visited: Vec<Entity>,
+    visited_before: Vec<Entity>,
+    slot_of: Vec<usize>,
+    /// Per joint: the substep length of its last impulse (s), NaN before its first.
+    h: Vec<f32>,
     /// Per joint, what the plan was made for (see [`topology_changed`]).
     topology: Vec<(usize, usize, usize)>,
     /// Per side, the geometric stiffness of its joints' pull (N·m per rad).
@@ -271,13 +279,47 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     s.entities.clear();
     s.index.clear();
     s.joints.clear();
+    // The joints in the order of their entities, whatever order the query visits them in: a
+    // restored snapshot builds its archetypes in an order of its own, and the solve's order
+    // (its rounding, its plan) must not depend on it.
+    s.visited.clear();
+    s.visited.extend(joints.iter().map(|(e, ..)| e));
+    if s.visited != s.visited_before {
+        s.visited_before.clone_from(&s.visited);
+        let mut by_entity: Vec<usize> = (0..s.visited.len()).collect();
+        by_entity.sort_unstable_by_key(|&k| s.visited[k]);
+        s.slot_of.clear();
+        s.slot_of.resize(by_entity.len(), 0);
+        for (slot, &k) in by_entity.iter().enumerate() {
+            s.slot_of[k] = slot;
+        }
+    }
+    let n = s.visited.len();
+    let mut described = vec![None; n];
     s.acc.clear();
-    for (joint, impulse) in joints.iter() {
+    s.acc.resize(n, Accumulated::default());
+    s.h.clear();
+    s.h.resize(n, f32::NAN);
+    for (k, (_, joint, impulse)) in joints.iter().enumerate() {
+        let slot = s.slot_of[k];
+        described[slot] = kinds::describe(joint);
+        s.h[slot] = impulse.h;
+        s.acc[slot] = Accumulated {
+            linear: impulse.linear.into(),
+            angular: impulse.angular.into(),
+            motor: impulse.motor,
+            lower: impulse.lower,
+            upper: impulse.upper,
+            swing: impulse.swing,
+            friction: impulse.friction.into(),
+        };
+    }
+    for (slot, described) in described.into_iter().enumerate() {
         // A body that is gone or quarantined leaves the joint inert: its partner runs free
         // (and the joint exerts nothing) until it is back.
         let gone = |e: Entity| !s.index.contains_key(&e) && bodies.get(e).is_err();
-        let described = kinds::describe(joint)
-            .filter(|j| !(j.bodies().a.is_some_and(gone) || gone(j.bodies().b)));
+        let described =
+            described.filter(|j| !(j.bodies().a.is_some_and(gone) || gone(j.bodies().b)));
         let Some(described) = described else {
             let inert = s.sides.len();
             s.sides.push(Side::WORLD);
@@ -288,24 +330,15 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
                 ..Rows::ball(Vec3A::ZERO, Vec3A::ZERO)
             };
             s.joints.push((rows, inert, inert));
-            s.acc.push(Accumulated::default());
+            s.acc[slot] = Accumulated::default();
             continue;
         };
         let ends = described.bodies();
         let (ia, local_a) = place(s, bodies, ends.a, ends.anchor_a);
         let (ib, local_b) = place(s, bodies, Some(ends.b), ends.anchor_b);
         s.joints.push((described.rows_at(local_a, local_b), ia, ib));
-        s.acc.push(Accumulated {
-            linear: impulse.linear.into(),
-            angular: impulse.angular.into(),
-            motor: impulse.motor,
-            lower: impulse.lower,
-            upper: impulse.upper,
-            swing: impulse.swing,
-            friction: impulse.friction.into(),
-        });
     }
-    stiffen_sides(s, joints, h);
+    stiffen_sides(s, h);
     if warm {
         for (j, (rows, ia, ib)) in s.joints.iter().enumerate() {
             let (ia, ib) = (*ia, *ib);
@@ -354,7 +387,9 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     for (side, &e) in s.sides.iter().zip(&s.entities) {
         store(bodies, e, side);
     }
-    for (((_, mut impulse), acc), (rows, ia, ib)) in joints.iter_mut().zip(&s.acc).zip(&s.joints) {
+    for (k, (_, _, mut impulse)) in joints.iter_mut().enumerate() {
+        let slot = s.slot_of[k];
+        let (acc, (rows, ia, ib)) = (&s.acc[slot], &s.joints[slot]);
         let (ia, ib) = (*ia, *ib);
         // Bookkeeping, not a change anyone listens for.
         let impulse = impulse.bypass_change_detection();
@@ -449,16 +484,15 @@ fn plan(s: &mut Scratch) {
 
 /// Stiffens the inertia of every moving side by the geometric stiffness of the forces its
 /// joints exerted in the last substep ([`solve::stiffen`]).
-fn stiffen_sides(s: &mut Scratch, joints: &Joints, h: f32) {
+fn stiffen_sides(s: &mut Scratch, h: f32) {
     s.stiffness.clear();
     s.stiffness.resize(s.sides.len(), Mat3A::ZERO);
     let mut any = false;
-    for ((&(ref rows, ia, ib), acc), (_, impulse)) in s.joints.iter().zip(&s.acc).zip(joints.iter())
-    {
-        if impulse.h.is_nan() || impulse.h <= 0.0 {
+    for ((&(ref rows, ia, ib), acc), &last) in s.joints.iter().zip(&s.acc).zip(&s.h) {
+        if last.is_nan() || last <= 0.0 {
             continue;
         }
-        let f = acc.linear / impulse.h;
+        let f = acc.linear / last;
         for (i, local) in [(ia, rows.local_a), (ib, rows.local_b)] {
             let side = &s.sides[i];
             if side.moves {

@@ -5,6 +5,7 @@ mod cones;
 mod door;
 mod hard_cases;
 mod kinematic_carriers;
+mod layout;
 mod limits;
 mod motors;
 mod pendulums;
