@@ -15,6 +15,7 @@ use common::register_fonts;
 
 mod chart;
 mod fem;
+mod joints;
 mod problems;
 
 use std::fmt::Write as _;
@@ -32,7 +33,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let quick = std::env::args().any(|a| a == "--quick");
     let start = Instant::now();
     type Build = fn(bool) -> hooke::Result<Problem>;
-    let all: [(&str, Build); 15] = [
+    let all: [(&str, Build); 17] = [
         ("oscillator", problems::oscillator),
         ("damped", problems::damped_oscillator),
         ("pendulum", problems::pendulum),
@@ -48,6 +49,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ("beam", fem::swinging_beam),
         ("cloth", problems::cloth),
         ("soft-bar", problems::soft_bar),
+        ("hinged-rod", joints::hinged_rod),
+        ("chain-gap", joints::chain_gap),
     ];
     let mut done = Vec::new();
     for (i, (name, build)) in all.iter().enumerate() {
@@ -65,7 +68,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all("out")?;
     std::fs::write("out/accuracy.md", &md)?;
     register_fonts()?;
-    let size = (1920, 1560);
+    let size = (1920, 1950);
     chart::draw(
         &BitMapBackend::new(Path::new("out/accuracy.png"), size).into_drawing_area(),
         &done,

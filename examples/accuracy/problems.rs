@@ -109,7 +109,7 @@ pub fn stiff_settings() -> Vec<Setting> {
     s
 }
 
-fn runs(quick: bool) -> u32 {
+pub fn runs(quick: bool) -> u32 {
     if quick { 1 } else { 7 }
 }
 

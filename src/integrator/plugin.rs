@@ -47,6 +47,7 @@ impl WorldPlugin for IntegratorPlugin {
         crate::core::restore::init::<Integrator>(world);
         crate::core::restore::init::<ConstraintsActive>(world);
         world.init_resource::<super::stages::Rk4Starts>();
+        world.init_resource::<super::stages::Rk4TurnStarts>();
         crate::core::restore::init::<super::StabilityPolicy>(world);
         crate::core::plugin::add_message::<super::StabilityWarning>(world);
         crate::core::restore::init::<super::stability::SharedNumericalDamping>(world);

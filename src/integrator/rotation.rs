@@ -3,6 +3,7 @@
 use bevy_ecs::prelude::*;
 use glam::Vec3A;
 
+use super::stages::Rk4TurnStarts;
 use super::{Integrator, IntegratorOverride};
 use crate::core::quarantine::{
     DivergenceGuard, QuarantineReason, Quarantined, quarantine_non_finite,
@@ -15,6 +16,7 @@ use crate::rigid::{
 };
 
 type AngularState<'a> = (
+    Entity,
     &'a mut Rotation,
     &'a mut AngularMomentum,
     &'a AngularVelocity,
@@ -24,15 +26,18 @@ type AngularState<'a> = (
 );
 
 /// The angular half of the velocity phase: L advances from τ (explicit Euler also turns q
-/// with the start-of-step ω here).
+/// with the start-of-step ω here). An RK4 body takes symplectic Euler's kick for the
+/// constraint solve, its start kept in [`Rk4TurnStarts`] for its stages.
 pub(super) fn integrate_angular_momenta(
     global: Res<Integrator>,
     update: Res<OrientationUpdate>,
     time: Res<SubstepTime>,
     mut bodies: Query<AngularState, Simulated>,
+    mut starts: ResMut<Rk4TurnStarts>,
 ) {
     let h = time.h;
-    for (mut q, mut l, w, t, inertia, o) in &mut bodies {
+    starts.0.clear();
+    for (e, mut q, mut l, w, t, inertia, o) in &mut bodies {
         let method = o.map_or(*global, |o| o.0);
         let kick = |l: Vec3A, scale: f32| {
             if inertia.is_infinite() {
@@ -50,7 +55,11 @@ pub(super) fn integrate_angular_momenta(
                 l.bypass_change_detection().0 = kick(l.0, 1.0);
             }
             Integrator::VelocityVerlet => l.bypass_change_detection().0 = kick(l.0, 0.5),
-            Integrator::Rk4 => {}
+            Integrator::Rk4 => {
+                let predicted = kick(l.0, 1.0);
+                starts.0.push((e, q.0, l.0, predicted));
+                l.bypass_change_detection().0 = predicted;
+            }
         }
     }
 }
@@ -79,7 +88,10 @@ pub(super) fn integrate_orientations(
         let method = o.map_or(*global, |o| o.0);
         if matches!(
             method,
-            Integrator::SymplecticEuler | Integrator::VelocityVerlet | Integrator::ImplicitEuler
+            Integrator::SymplecticEuler
+                | Integrator::VelocityVerlet
+                | Integrator::ImplicitEuler
+                | Integrator::Rk4
         ) {
             let strang = method == Integrator::VelocityVerlet;
             q.0 = turn(q.0, l.0, w.0, inertia, h, *update, strang);

@@ -113,6 +113,13 @@ impl AngularRk4 {
 #[derive(Resource, Debug, Default)]
 pub(crate) struct Rk4Starts(pub Vec<(Entity, Vec3A, Vec3A, Vec3A)>);
 
+/// Each RK4 body's (q₀, L₀) at the substep's start and the angular momentum the symplectic
+/// kick gave it for the constraint solve (written by the velocity phase): as for
+/// [`Rk4Starts`], a body no constraint touched takes RK4's stages from the start, one a
+/// constraint touched keeps the symplectic turn that the constraint saw.
+#[derive(Resource, Debug, Default)]
+pub(crate) struct Rk4TurnStarts(pub Vec<(Entity, Quat, Vec3A, Vec3A)>);
+
 /// Reused allocations of [`complete_stages`].
 #[derive(Default)]
 pub(crate) struct StageScratch {
@@ -124,6 +131,8 @@ pub(crate) struct StageScratch {
     verlet_rotations: Vec<Entity>,
     /// [`Rk4Starts`] by entity.
     starts: std::collections::HashMap<Entity, (Vec3A, Vec3A, Vec3A)>,
+    /// [`Rk4TurnStarts`] by entity.
+    turn_starts: std::collections::HashMap<Entity, (Quat, Vec3A, Vec3A)>,
 }
 
 type StageBody<'a> = (
@@ -210,9 +219,24 @@ pub(crate) fn complete_stages(
         }
         s.meshes.push((e, method, stages));
     }
+    s.turn_starts.clear();
+    s.turn_starts.extend(
+        world
+            .resource::<Rk4TurnStarts>()
+            .0
+            .iter()
+            .map(|&(e, q0, l0, lp)| (e, (q0, l0, lp))),
+    );
     for (e, mut q, mut l, mut w, t, inertia, o) in rotations.iter_mut(world) {
         match o.map_or(global, |o| o.0) {
             Integrator::Rk4 => {
+                if let Some(&(q0, l0, predicted)) = s.turn_starts.get(&e) {
+                    if l.0 != predicted {
+                        continue;
+                    }
+                    q.0 = q0;
+                    l.bypass_change_detection().0 = l0;
+                }
                 let mut r = AngularRk4::begin(q.0, l.0);
                 let omega = crate::rigid::omega_of(inertia, q.0, l.0, w.0);
                 let tau = if inertia.is_infinite() {
