@@ -266,6 +266,22 @@ pub enum Spawn {
 pub enum JointKind {
     /// Holds the anchors together; every turn free.
     Ball,
+    /// A ball joint whose turns are limited about `axis` (each body's axis as spawned, like
+    /// a shoulder's): the swing, the angle between the two sides' axes, within a cone; the
+    /// twist about the axis within a range; and friction resisting any turn.
+    LimitedBall {
+        /// The joint's axis.
+        axis: Vec3,
+        /// The cone's half-angle (degrees, in (0, 180)).
+        #[serde(default)]
+        swing: Option<f32>,
+        /// The twist's range (degrees, within ±180).
+        #[serde(default)]
+        twist: Option<(f32, f32)>,
+        /// The most torque friction gives against any turn (N·m).
+        #[serde(default)]
+        friction: Option<f32>,
+    },
     /// A hinge about `axis`.
     Hinge {
         /// The hinge axis.
@@ -411,6 +427,21 @@ pub enum Action {
         joint: String,
         /// Target speed (rad/s for a hinge, m/s for a slider).
         target_velocity: f32,
+        /// The most torque (N·m) or force (N) it gives.
+        max: f32,
+    },
+    /// Sets a hinge's or a slider's position motor (servo): the target (degrees for a hinge,
+    /// m for a slider), stiffness (N·m/rad or N/m), damping (N·m·s/rad or N·s/m) and the
+    /// most torque or force it gives (N·m or N); it takes the place of any motor.
+    SetServo {
+        /// The joint.
+        joint: String,
+        /// Target angle (degrees) or offset (m).
+        target: f32,
+        /// Stiffness (N·m/rad or N/m).
+        stiffness: f32,
+        /// Damping (N·m·s/rad or N·s/m).
+        damping: f32,
         /// The most torque (N·m) or force (N) it gives.
         max: f32,
     },

@@ -631,7 +631,7 @@ fn check_action(
             selector_at(r, lives, entity, a.line, (s, s), despawning)?;
         }
         Action::Spawn { spawn, .. } => ends(r, lives, spawn, a.line, s)?,
-        Action::SetMotor { joint, .. } => {
+        Action::SetMotor { joint, .. } | Action::SetServo { joint, .. } => {
             selector_at(r, lives, joint, a.line, (s, s), false)?;
             let name = joint.split('[').next().unwrap_or(joint);
             if !lives.get(name).is_some_and(|l| l.motor) {

@@ -311,6 +311,17 @@ fn act(
                 spawn::set_motor(world, e, *target_velocity, *max)?;
             }
         }
+        Action::SetServo {
+            joint,
+            target,
+            stiffness,
+            damping,
+            max,
+        } => {
+            for e in group(names, joint) {
+                spawn::set_servo(world, e, *target, (*stiffness, *damping, *max))?;
+            }
+        }
         Action::SetVelocity { entity, velocity } => {
             let v = finite_vec("velocity", *velocity)?;
             for e in group(names, entity) {

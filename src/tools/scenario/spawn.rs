@@ -291,6 +291,28 @@ fn joint<'w>(world: &'w mut World, kind: &JointKind, sides: &Sides) -> Result<En
             Some(a) => SphericalJoint::new(a, b),
             None => SphericalJoint::to_world(b),
         }),
+        JointKind::LimitedBall {
+            axis,
+            swing,
+            twist,
+            friction,
+        } => {
+            let mut j = match a {
+                Some(a) => SphericalJoint::new(a, b),
+                None => SphericalJoint::to_world(b),
+            }
+            .with_axis(axis);
+            if let Some(max) = swing {
+                j = j.with_swing_limit(max.to_radians());
+            }
+            if let Some((min, max)) = twist {
+                j = j.with_twist_limits(min.to_radians(), max.to_radians());
+            }
+            if let Some(torque) = friction {
+                j = j.with_friction(torque);
+            }
+            placed!(j)
+        }
         JointKind::Hinge {
             axis,
             limits,
@@ -357,6 +379,28 @@ fn joint<'w>(world: &'w mut World, kind: &JointKind, sides: &Sides) -> Result<En
 }
 
 /// Sets the motor of the hinge or slider `e`.
+/// Sets joint `e`'s position motor (servo): `target` in degrees for a hinge, m for a slider.
+pub(super) fn set_servo(
+    world: &mut World,
+    e: Entity,
+    target: f32,
+    (stiffness, damping, max): (f32, f32, f32),
+) -> Result<()> {
+    finite("servo target", target)?;
+    non_negative("servo stiffness", stiffness)?;
+    non_negative("servo damping", damping)?;
+    non_negative("servo maximum", max)?;
+    if let Some(mut j) = world.get_mut::<RevoluteJoint>(e) {
+        *j = j.with_position_motor(target.to_radians(), stiffness, damping, max);
+    } else if let Some(mut j) = world.get_mut::<PrismaticJoint>(e) {
+        *j = j.with_position_motor(target, stiffness, damping, max);
+    } else {
+        // The loader checked it was spawned a hinge or a slider: it broke or was taken off.
+        return Err(Error::NoMotor(e));
+    }
+    Ok(())
+}
+
 pub(super) fn set_motor(
     world: &mut World,
     e: Entity,

@@ -180,15 +180,28 @@ fn a_motor_on_a_joint_that_takes_none_is_refused_with_its_line() {
 }
 
 #[test]
-fn a_joint_with_a_bad_axis_is_a_build_error_with_its_line() {
-    let s = load("bad_joint_axis.ron").expect("the file itself is well formed");
-    let e = s.run().expect_err("a zero axis");
+fn a_joint_with_a_bad_axis_or_cone_is_a_build_error_with_its_line() {
+    // A hinge about no axis; a ball joint's cone of 200°.
+    for file in ["bad_joint_axis.ron", "cone_past_half_a_turn.ron"] {
+        let s = load(file).expect("the file itself is well formed");
+        let e = s.run().expect_err(file);
+        assert!(
+            matches!(
+                e.kind,
+                ScenarioErrorKind::Build(hooke::Error::OutOfRange { .. })
+            ),
+            "{file}: {e}"
+        );
+        assert_eq!(e.line, 6, "{file}");
+    }
+}
+
+#[test]
+fn a_servo_on_a_joint_without_an_axis_is_refused_with_its_line() {
+    let e = error("servo_on_a_ball_joint.ron");
     assert!(
-        matches!(
-            e.kind,
-            ScenarioErrorKind::Build(hooke::Error::OutOfRange { .. })
-        ),
+        matches!(&e.kind, ScenarioErrorKind::BadValue(m) if m.contains("only they take a motor")),
         "{e}"
     );
-    assert_eq!(e.line, 6);
+    assert_eq!(e.line, 9);
 }
