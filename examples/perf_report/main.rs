@@ -412,17 +412,23 @@ fn main() {
     if run("contacts") {
         contacts::contact_scenes(&cfg, quick);
     }
+    // `--scene NAME` runs one scene of the box3d or joints group.
+    let scene = std::env::args()
+        .skip_while(|a| a != "--scene")
+        .nth(1)
+        .unwrap_or_default();
     if run("box3d") {
-        // `--scene large_pyramid|many_pyramids|convex_pile|joint_grid|washer` runs one.
-        let scene = std::env::args()
-            .skip_while(|a| a != "--scene")
-            .nth(1)
-            .unwrap_or_default();
+        // large_pyramid|many_pyramids|convex_pile|joint_grid|washer
         box3d::box3d_suite(quick, &scene);
     }
     if run("joints") {
-        joints::chain_vs_rapier(if quick { 3 } else { 5 }, if quick { 60 } else { 300 });
-        joints::ragdolls_vs_rapier(if quick { 3 } else { 5 }, if quick { 60 } else { 300 });
+        let (runs, steps) = if quick { (3, 60) } else { (5, 300) };
+        if scene.is_empty() || scene == "chain" {
+            joints::chain_vs_rapier(runs, steps);
+        }
+        if scene.is_empty() || scene == "ragdolls" {
+            joints::ragdolls_vs_rapier(runs, steps);
+        }
     }
     if run("scaling") {
         scaling::scaling_lines(&cfg, quick);

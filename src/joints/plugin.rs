@@ -4,6 +4,7 @@
 use bevy_ecs::prelude::*;
 use glam::{Mat3A, Vec3, Vec3A};
 
+use bevy_ecs::entity::EntityHashMap;
 use bevy_platform::collections::HashMap;
 
 use super::axial;
@@ -57,6 +58,7 @@ impl WorldPlugin for JointPlugin {
                 .before(FinishSystems::Diagnostics),
         );
         crate::core::restore::init::<super::JointDiagnostics>(world);
+        world.init_resource::<Scratch>();
         // The whole-step path knows no joints: worlds with one take the schedule.
         crate::core::whole_step::block_on::<SphericalJoint>(world);
         crate::core::whole_step::block_on::<RevoluteJoint>(world);
@@ -119,7 +121,7 @@ fn solve_joints(
     settings: Res<JointSettings>,
     mut joints: Joints,
     mut bodies: Bodies,
-    mut scratch: Local<Scratch>,
+    mut scratch: ResMut<Scratch>,
 ) {
     let hertz = settings.hertz.min(0.25 / time.h);
     let soft = crate::collision::solver::Softness::new(hertz, settings.damping_ratio, time.h);
@@ -138,7 +140,7 @@ fn relax_joints(
     time: Res<SubstepTime>,
     mut joints: Joints,
     mut bodies: Bodies,
-    mut scratch: Local<Scratch>,
+    mut scratch: ResMut<Scratch>,
 ) {
     pass(
         &mut joints,
@@ -200,15 +202,16 @@ fn store(bodies: &mut Bodies, e: Option<Entity>, side: &Side) {
     }
 }
 
-/// A pass's working set, kept to reuse its memory.
-#[derive(Default)]
+/// The passes' working set, kept to reuse its memory, the plan and the groups' layouts (both
+/// passes share them).
+#[derive(Default, Resource)]
 struct Scratch {
     /// Every side the pass reads: each moving body once, then immovable sides per joint.
     sides: Vec<Side>,
     /// Per side: its centre of mass in its shape frame (m).
     coms: Vec<Vec3>,
     entities: Vec<Option<Entity>>,
-    index: HashMap<Entity, usize>,
+    index: EntityHashMap<usize>,
     /// Per joint: its geometry and its sides' places in `sides`.
     joints: Vec<(Rows, usize, usize)>,
     acc: Vec<Accumulated>,
@@ -220,6 +223,8 @@ struct Scratch {
     order: Vec<(usize, usize)>,
     rows: Vec<Row>,
     system: Envelope,
+    /// Per group solved as one system, its system.
+    systems: Vec<Envelope>,
     ordering: Ordering,
     forest: Forest,
     /// A group's joints while it is planned, and where its trees end.
@@ -354,6 +359,9 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
     // Motors (and the limits no group takes) first, each on its own (Box2D's order): the
     // rows after them keep what they leave free, the free axis.
     free_axes(s, mode, h, warm);
+    if s.systems.len() < s.groups.len() {
+        s.systems.resize_with(s.groups.len(), Envelope::default);
+    }
     for g in 0..s.groups.len() {
         let (k, end, how) = s.groups[g];
         if how == GroupSolve::Whole {
@@ -362,7 +370,8 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
                 let j = s.order[i].1;
                 push_rows(s, j, h);
             }
-            envelope::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.system);
+            let system = &mut s.systems[g];
+            envelope::solve(&s.rows, &mut s.sides, &mut s.acc, mode, system);
         } else {
             // A mesh of loops (a net, a grid): the tree would leave most joints to be solved
             // after it anyway, so each joint is solved on its own, as Box2D solves them.
@@ -380,7 +389,8 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
                 }
                 s.rows.clear();
                 push_rows(s, j, h);
-                envelope::solve(&s.rows, &mut s.sides, &mut s.acc, mode, &mut s.system);
+                let system = &mut s.system;
+                envelope::solve(&s.rows, &mut s.sides, &mut s.acc, mode, system);
             }
         }
     }
