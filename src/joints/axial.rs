@@ -186,10 +186,14 @@ pub(super) fn warm_start(rows: &Rows, acc: &Accumulated, a: &mut Side, b: &mut S
 #[must_use]
 pub(super) fn world_impulse(rows: &Rows, acc: &Accumulated, a: &Side, b: &Side) -> (Vec3, Vec3) {
     let total = acc.motor + acc.lower - acc.upper;
-    let swing = match measure_swing(rows, a, b) {
-        Some((m, _)) if acc.swing != 0.0 => Vec3::from(-acc.swing * m.n),
+    // Measured only where an impulse needs its axis: most joints hold none.
+    let swing = match (acc.swing != 0.0).then(|| measure_swing(rows, a, b)) {
+        Some(Some((m, _))) => Vec3::from(-acc.swing * m.n),
         _ => Vec3::ZERO,
     } + Vec3::from(acc.friction);
+    if total == 0.0 {
+        return (Vec3::ZERO, swing);
+    }
     match measure(rows, a, b) {
         Some(m) if total != 0.0 && m.linear => ((total * m.n).into(), swing),
         Some(m) if total != 0.0 => (Vec3::ZERO, Vec3::from(total * m.n) + swing),

@@ -258,15 +258,25 @@ fn factor(s: &mut Envelope, from: usize, eps: f64, floor: f64) {
         }
         let (before, row) = s.values.split_at_mut(op);
         let row = &mut row[..len];
+        let (first, offset) = (&s.first[..p], &s.offset[..p]);
         for q in fp.max(from)..p {
-            let (fq, oq) = (s.first[q], s.offset[q]);
+            let (fq, oq) = (first[q], offset[q]);
             let k0 = fp.max(fq);
-            let mine = &row[k0 - fp..q - fp];
-            let theirs = &before[oq + k0 - fq..oq + q - fq];
-            let dot: f64 = mine.iter().zip(theirs).map(|(a, b)| a * b).sum();
-            row[q - fp] = (row[q - fp] - dot) / s.diagonal[q];
+            let (mine, rest) = row.split_at_mut(q - fp);
+            let mine = &mine[k0 - fp..];
+            let theirs = &before[oq + k0 - fq..][..mine.len()];
+            // Summed in order from −0.0, as `Iterator::sum` does: the bits of the factor do
+            // not depend on how this loop is written.
+            let mut dot = -0.0_f64;
+            for (a, b) in mine.iter().zip(theirs) {
+                dot += a * b;
+            }
+            rest[0] = (rest[0] - dot) / s.diagonal[q];
         }
-        let own: f64 = row[..len - 1].iter().map(|a| a * a).sum();
+        let mut own = -0.0_f64;
+        for a in &row[..len - 1] {
+            own += a * a;
+        }
         let d = row[len - 1] + eps - own;
         s.diagonal[p] = if d.is_nan() || d <= floor {
             f64::INFINITY
