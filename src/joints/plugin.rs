@@ -402,7 +402,7 @@ fn pass(joints: &mut Joints, bodies: &mut Bodies, mode: Mode, warm: bool, h: f32
                 push_rows(s, j, h);
             }
             let system = &mut s.systems[g];
-            envelope::solve(&s.rows, &mut s.sides, &mut s.acc, mode, system);
+            envelope::solve(&s.rows, &mut s.sides, &mut s.acc, mode.exact(), system);
         } else {
             // A mesh of loops (a net, a grid): the tree would leave most joints to be solved
             // after it anyway, so each joint is solved on its own, as Box2D solves them.
