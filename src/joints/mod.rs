@@ -249,6 +249,11 @@ impl JointImpulse {
 }
 
 /// How stiffly the joints' biased pass pulls drifted anchors back.
+///
+/// Joints solved one at a time (motors, a net's loop joints) are soft springs of this
+/// frequency and damping ratio (Box2D's soft step). A group of joints solved as one system
+/// takes only the rate at which such a spring closes a gap: it holds its whole load, so a
+/// load does not stretch it (see `docs/joints.md`, "Exact groups are not springs").
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
 pub struct JointSettings {
     /// Frequency of the correcting spring (Hz), capped at a quarter of the substep rate.
