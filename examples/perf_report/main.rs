@@ -424,10 +424,13 @@ fn main() {
     if run("joints") {
         let (runs, steps) = if quick { (3, 60) } else { (5, 300) };
         if scene.is_empty() || scene == "chain" {
-            joints::chain_vs_rapier(runs, steps);
+            joints::chain_vs_rapier(runs, steps, !quick);
         }
         if scene.is_empty() || scene == "ragdolls" {
-            joints::ragdolls_vs_rapier(runs, steps);
+            joints::ragdolls_vs_rapier(runs, steps, !quick);
+        }
+        if !quick && (scene.is_empty() || scene == "joint_grid") {
+            joints::joint_grid_at_equal_gap(3);
         }
     }
     if run("scaling") {
