@@ -8,6 +8,9 @@
 //! [`TransformExtrapolation`] instead predicts ahead from the last step with the body's
 //! velocities, t = t₁ + v α dt, r = exp(ω α dt) r₁: no lag, but it overshoots when a body
 //! changes course (and assumes the body has no parent).
+//!
+//! A `Transform` the game writes is never smoothed over: until the next step reads it as a
+//! teleport, the frames show it as written, and the smoothing restarts from it.
 
 use bevy_app::{App, Plugin, RunFixedMainLoop, RunFixedMainLoopSystems};
 use bevy_ecs::prelude::*;
@@ -91,7 +94,9 @@ fn smooth_transforms(fixed: Option<Res<Time<Fixed>>>, mut bodies: Query<Smoothed
     let alpha = fixed.overstep_fraction();
     let ahead = fixed.overstep().as_secs_f32();
     for (h, mut t, mut synced, extrapolate, v, w) in &mut bodies {
-        if !h.seeded {
+        // A `Transform` that is not the one hooke last wrote was written by the game: a
+        // teleport the next step reads (`read_transforms`), shown as written until then.
+        if !h.seeded || !synced.matches(&t) {
             continue;
         }
         let [(t0, r0), (t1, r1)] = h.poses();

@@ -3,3 +3,4 @@
 mod app;
 mod preludes;
 mod required_components_spawning;
+mod teleports_under_interpolation;
