@@ -2,7 +2,9 @@
 //! fixed step (`TimeUpdateStrategy::FixedTimesteps(1)`) against one `step_physics` on a bare
 //! `World` holding the same scene. The App side pays everything a game pays per step: the
 //! main schedule, `Time`, Transform reads and writes, message registration and Bevy's own
-//! transform propagation.
+//! transform propagation. With `--features debug-plugin`, the heap again with the debug view
+//! added (and Bevy's gizmo and asset plugins it draws through): switched off in its gizmo
+//! config, and on.
 
 use bevy_app::prelude::*;
 use bevy_ecs::prelude::*;
@@ -20,9 +22,32 @@ fn settings(world: &mut World) {
     world.resource_mut::<hooke::sleep::SleepSettings>().enabled = false;
 }
 
-fn app(spawn: &dyn Fn(&mut World)) -> App {
+/// Whether the App has the debug view, and whether it is switched on.
+#[derive(Clone, Copy, PartialEq)]
+enum Debug {
+    Absent,
+    Off,
+    On,
+}
+
+fn app(spawn: &dyn Fn(&mut World), debug: Debug) -> App {
     let mut app = App::new();
     app.add_plugins((TimePlugin, TransformPlugin, PhysicsPlugins));
+    #[cfg(not(feature = "debug-plugin"))]
+    let _ = debug;
+    #[cfg(feature = "debug-plugin")]
+    if debug != Debug::Absent {
+        use bevy_gizmos::config::{GizmoConfig, GizmoConfigStore};
+        app.add_plugins((
+            bevy_app::TaskPoolPlugin::default(),
+            bevy_asset::AssetPlugin::default(),
+            bevy_gizmos::GizmoPlugin,
+            hooke::bevy::PhysicsDebugPlugin,
+        ));
+        let mut store = app.world_mut().resource_mut::<GizmoConfigStore>();
+        let (config, _): (&mut GizmoConfig, _) = store.config_mut::<hooke::bevy::PhysicsGizmos>();
+        config.enabled = debug == Debug::On;
+    }
     app.insert_resource(Time::<Fixed>::from_hz(60.0));
     app.insert_resource(TimeUpdateStrategy::FixedTimesteps(1));
     app.finish();
@@ -41,7 +66,7 @@ fn bare(spawn: &dyn Fn(&mut World)) -> World {
 }
 
 /// A scene: its name, how it spawns, the steps to settle first, and the line's note.
-type Scene<'a> = (&'a str, &'a dyn Fn(&mut World), usize, &'a str);
+type Scene<'a> = (&'a str, &'a dyn Fn(&mut World), usize, &'a str, Debug);
 
 pub fn bevy_layer(cfg: &Config) {
     let falling = scenes::falling_boxes_spec(1000);
@@ -49,22 +74,40 @@ pub fn bevy_layer(cfg: &Config) {
         scenes::spawn_boxes(w, &falling).unwrap();
     };
     let tumbling = |w: &mut World| scenes::tumbling_boxes(w, 1000).unwrap();
-    let scenes: [Scene; 2] = [
+    let mut scenes: Vec<Scene> = vec![
         (
             "heap1000",
             &heap,
             240,
             "1,000 boxes resting on the ground; goal <= 1.10",
+            Debug::Absent,
         ),
         (
             "tumbling1000",
             &tumbling,
             0,
             "1,000 free tumbling boxes, no contacts: the layer against the cheapest step",
+            Debug::Absent,
         ),
     ];
-    for (name, spawn, settle, note) in scenes {
-        let mut a = app(spawn);
+    if cfg!(feature = "debug-plugin") {
+        scenes.push((
+            "heap1000_debug_view_off",
+            &heap,
+            240,
+            "the heap with PhysicsDebugPlugin added, its gizmo config disabled; goal <= 1.10",
+            Debug::Off,
+        ));
+        scenes.push((
+            "heap1000_debug_view_on",
+            &heap,
+            240,
+            "the heap drawn: its colliders and contacts into the gizmo buffers each update",
+            Debug::On,
+        ));
+    }
+    for (name, spawn, settle, note, debug) in scenes {
+        let mut a = app(spawn, debug);
         let mut w = bare(spawn);
         // Bevy's first update starts its clock and runs no fixed step.
         a.update();

@@ -45,10 +45,14 @@
 //! RigidBodyPlugin, CollisionPlugin))` takes only what a game needs (add
 //! [`PhysicsSchedulePlugin`] too, or nothing steps).
 
+#[cfg(feature = "debug-plugin")]
+mod debug;
 mod diagnostics;
 mod interpolation;
 mod transform;
 
+#[cfg(feature = "debug-plugin")]
+pub use debug::{ContactGizmoScale, PhysicsDebugPlugin, PhysicsGizmos};
 pub use diagnostics::PhysicsDiagnosticsPlugin;
 pub use interpolation::{
     PhysicsInterpolationPlugin, PoseHistory, TransformExtrapolation, TransformInterpolation,

@@ -231,34 +231,7 @@ impl TetMesh {
     /// its normal points out of the body. For rendering and contact.
     #[must_use]
     pub fn surface(&self) -> Vec<[u32; 3]> {
-        let mut faces: Vec<([u32; 3], [u32; 3])> = Vec::with_capacity(4 * self.tets.len());
-        for t in &self.tets {
-            // Outward-wound faces of a positively oriented tet.
-            for f in [
-                [t[1], t[2], t[3]],
-                [t[0], t[3], t[2]],
-                [t[0], t[1], t[3]],
-                [t[0], t[2], t[1]],
-            ] {
-                let mut key = f;
-                key.sort_unstable();
-                faces.push((key, f));
-            }
-        }
-        faces.sort_unstable_by_key(|f| f.0);
-        let mut out = Vec::new();
-        let mut i = 0;
-        while i < faces.len() {
-            let mut j = i + 1;
-            while j < faces.len() && faces[j].0 == faces[i].0 {
-                j += 1;
-            }
-            if j - i == 1 {
-                out.push(faces[i].1);
-            }
-            i = j;
-        }
-        out
+        surface_of(&self.tets)
     }
 }
 
@@ -273,4 +246,52 @@ pub fn signed_volume(points: &[Vec3], t: [u32; 4]) -> f32 {
     let p = |i: usize| points[t[i] as usize];
     let m = Mat3::from_cols(p(1) - p(0), p(2) - p(0), p(3) - p(0));
     m.determinant() / 6.0
+}
+
+/// The boundary of `tets`: every triangle that belongs to exactly one tetrahedron, wound so
+/// that its normal points out of a positively oriented mesh.
+#[must_use]
+pub(crate) fn surface_of(tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
+    let mut faces: Vec<([u32; 3], [u32; 3])> = Vec::with_capacity(4 * tets.len());
+    for t in tets {
+        // Outward-wound faces of a positively oriented tet.
+        for f in [
+            [t[1], t[2], t[3]],
+            [t[0], t[3], t[2]],
+            [t[0], t[1], t[3]],
+            [t[0], t[2], t[1]],
+        ] {
+            let mut key = f;
+            key.sort_unstable();
+            faces.push((key, f));
+        }
+    }
+    faces.sort_unstable_by_key(|f| f.0);
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < faces.len() {
+        let mut j = i + 1;
+        while j < faces.len() && faces[j].0 == faces[i].0 {
+            j += 1;
+        }
+        if j - i == 1 {
+            out.push(faces[i].1);
+        }
+        i = j;
+    }
+    out
+}
+
+/// The edges of the boundary of `tets` ([`surface_of`]), each once, sorted.
+#[cfg(feature = "debug-plugin")]
+#[must_use]
+pub(crate) fn surface_edges(tets: &[[u32; 4]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = surface_of(tets)
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
 }

@@ -1,6 +1,7 @@
 //! The Bevy layer: App clock, Transform sync, spawning by required components, prelude imports.
 
 mod app;
+mod debug_view;
 mod preludes;
 mod required_components_spawning;
 mod teleports_under_interpolation;
