@@ -42,6 +42,7 @@ pub use crate::core::rest::{SleepTimer, Sleeping, SleepingDisabled};
 
 /// When islands fall asleep.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct SleepSettings {
     /// Whether bodies may sleep at all.
     pub enabled: bool,

@@ -24,18 +24,21 @@ use crate::rigid::AngularVelocity;
 
 /// Interpolates this entity's rendered `Transform` between the last two physics steps.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(PoseHistory)]
 pub struct TransformInterpolation;
 
 /// Extrapolates this entity's rendered `Transform` ahead of the last physics step from its
 /// velocities.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(PoseHistory)]
 pub struct TransformExtrapolation;
 
 /// The `Transform` poses of the last two physics steps, kept by hooke for entities with
 /// [`TransformInterpolation`] or [`TransformExtrapolation`].
 #[derive(Component, Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct PoseHistory {
     previous: (Vec3, Quat),
     current: (Vec3, Quat),

@@ -49,6 +49,7 @@
 mod debug;
 mod diagnostics;
 mod interpolation;
+mod reflect;
 mod transform;
 
 #[cfg(feature = "debug-plugin")]
@@ -152,6 +153,7 @@ fn register_messages(world: &mut World) {
 impl Plugin for PhysicsSchedulePlugin {
     fn build(&self, app: &mut App) {
         register_messages(app.world_mut());
+        reflect::register_types(app);
         app.world_mut().add_physics(PhysicsCorePlugin);
         app.insert_resource(AppSchedule(self.schedule));
         app.configure_sets(
@@ -242,6 +244,7 @@ impl PluginGroup for PhysicsPlugins {
 
 /// The `Transform` hooke last wrote or read for this entity. Added by hooke.
 #[derive(Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct SyncedTransform {
     translation: Vec3,
     rotation: Quat,

@@ -41,6 +41,7 @@ use crate::springs::SpringNetwork;
 /// A cloth's surface over the [`Nodes`] and [`SpringNetwork`] on the same entity (see the
 /// module docs).
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct Cloth {
     triangles: Vec<[u32; 3]>,
     /// The springs strain limiting holds (the structural ones).

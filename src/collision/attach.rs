@@ -41,6 +41,7 @@ use crate::rigid::{CenterOfMass, ComputedMass, Inertia, RigidBody, Rotation};
 
 /// Density of a collider (kg/m³), used when hooke computes a body's mass from its colliders.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = density_changed)]
 pub struct ColliderDensity(pub f32);
 
@@ -77,6 +78,7 @@ fn density_changed(mut world: DeferredWorld, ctx: HookContext) {
 /// Where a child collider sits in its parent's frame (m and a unit quaternion). With the
 /// `bevy` feature hooke writes it from the child's `Transform`.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = offset_changed)]
 pub struct ColliderOffset {
     /// Translation in the parent's frame (m).
@@ -126,6 +128,7 @@ fn offset_changed(mut world: DeferredWorld, ctx: HookContext) {
 /// Set by hooke on a child collider that is part of the body `body`. The child's own
 /// [`Position`] and [`Rotation`] follow the body; the collision systems see only the body.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = attachment_changed, on_remove = attachment_changed)]
 pub struct ColliderOf {
     /// The body this collider is part of.

@@ -82,6 +82,7 @@ pub use plugin::CollisionPlugin;
 /// (a joint between the two is one, see [`crate::joints`]), and collides again when none is
 /// left.
 #[derive(Resource, Debug, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct PairExclusions(bevy_platform::collections::HashMap<(Entity, Entity), u32>);
 
 impl PairExclusions {
@@ -199,6 +200,11 @@ use crate::rigid::{CenterOfMass, Rotation};
     crate::core::rest::SleepTimer
 )]
 #[cfg_attr(feature = "bevy", require(bevy_transform::components::Transform))]
+#[cfg_attr(
+    feature = "bevy",
+    derive(bevy_reflect::Reflect),
+    reflect(opaque, Component, Clone)
+)]
 #[component(on_insert = collider_changed, on_remove = collider_changed)]
 pub struct Collider {
     shape: SharedShape,
@@ -326,6 +332,7 @@ fn collider_changed(
 /// collision detection: what touched them must hear of it (the sleep plugin wakes their
 /// islands, whose pairs the narrow phase then updates or ends).
 #[derive(Resource, Debug, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct ColliderChanges(pub(crate) Vec<Entity>);
 
 impl ColliderChanges {
@@ -607,6 +614,7 @@ fn positive_len(what: &'static str, v: f32) -> Result<f32> {
 
 /// Coulomb friction coefficient μ (dimensionless, default 0.5).
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct Friction(pub f32);
 
@@ -626,6 +634,7 @@ impl Validate for Friction {
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct Restitution(pub f32);
 
@@ -648,6 +657,7 @@ impl Validate for Restitution {
 /// too (a ball's bounce series goes on longer); too small, and a resting body jitters on the
 /// bounces of its own settling.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct RestitutionThreshold(pub f32);
 
@@ -659,6 +669,7 @@ impl Validate for RestitutionThreshold {
 
 /// How two colliders' coefficients combine into one for their contact.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub enum CombineRule {
     /// √(a b): the default for friction.
     #[default]
@@ -690,6 +701,7 @@ impl CombineRule {
 /// Which colliders may touch: a pair interacts when each one's `memberships` meets the
 /// other's `filters`. Default: every layer, colliding with every layer.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct CollisionLayers {
     /// Layers this collider is on (bit mask).
     pub memberships: u32,
@@ -719,6 +731,7 @@ impl CollisionLayers {
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct Sensor;
 
 /// The world bounding box of a collider as of the last step (m), grown by its speculative
@@ -726,6 +739,7 @@ pub struct Sensor;
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct ColliderAabb {
     /// Lower corner.
     pub min: Vec3,
@@ -735,6 +749,7 @@ pub struct ColliderAabb {
 
 /// Contact solver settings (Box2D v3's, except for the stiffness cap; see [`ContactSettings::hertz`]).
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct ContactSettings {
     /// Stiffness of the soft contact, as a frequency (Hz), capped at an eighth of the
     /// substep rate: 30 Hz with 4 substeps at 60 Hz, the full 60 Hz from 8 substeps. A stack
@@ -823,6 +838,7 @@ pub struct ContactEnd {
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct CollisionEventsEnabled;
 
 /// Written when two colliders stop touching (or are despawned while touching).

@@ -29,6 +29,7 @@ use crate::core::schedule::{
 
 /// How many things of each kind the world holds (quarantined ones counted apart).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct BodyCounts {
     /// Particle entities (with [`Mass`](crate::particles::Mass)).
     pub particles: usize,
@@ -50,6 +51,7 @@ pub struct BodyCounts {
 
 /// Diagnostics of the last step. A resource.
 #[derive(Resource, Debug, Clone, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct PhysicsDiagnostics {
     /// Kinetic energy, translational plus rotational (J).
     pub kinetic_energy: f64,
@@ -122,6 +124,7 @@ impl PhysicsDiagnostics {
 
 /// What the diagnostics measure.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct DiagnosticsSettings {
     /// Compute energies, momentum and counts every step (one read of every body).
     pub energy: bool,

@@ -25,6 +25,11 @@ use crate::core::error::Error;
 
 /// Why a body was taken out of the simulation.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[cfg_attr(
+    feature = "bevy",
+    derive(bevy_reflect::Reflect),
+    reflect(opaque, Clone, Debug, PartialEq)
+)]
 pub enum QuarantineReason {
     /// Its position or velocity became NaN or infinite during a step.
     NonFiniteState,
@@ -98,6 +103,7 @@ impl core::fmt::Display for QuarantineReason {
 /// `f32::INFINITY` to turn that check off. Read from a file (a snapshot), every limit must be
 /// positive and not NaN (a NaN limit would turn its check off unseen).
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 #[serde(try_from = "GuardRecord")]
 pub struct DivergenceGuard {
     /// Speed beyond any body's in a game (m/s; default 1e4, ten times a rifle bullet's).
@@ -238,6 +244,7 @@ mod error_text {
 
 /// Marks a body that is no longer simulated. See the module docs.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_add = report_quarantine)]
 pub struct Quarantined {
     /// Why.

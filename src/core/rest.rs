@@ -11,18 +11,21 @@ use bevy_ecs::prelude::*;
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct Sleeping;
 
 /// Keeps a body from ever sleeping.
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct SleepingDisabled;
 
 /// How long (s) the body has been slower than the sleep thresholds.
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct SleepTimer(pub f32);
 
 /// The bodies a substep moves: neither quarantined nor asleep. The query filter of every

@@ -13,6 +13,7 @@ use crate::core::error::{Error, Result};
 /// The fixed step and the simulation clock. Read from a file (a snapshot), it is checked as
 /// [`PhysicsTime::new`] checks its input.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 #[serde(try_from = "TimeRecord")]
 pub struct PhysicsTime {
     dt: f32,
@@ -221,6 +222,7 @@ impl PhysicsTime {
 
 /// The current substep: its length and start time. Read by time-dependent effects.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct SubstepTime {
     /// Substep length h (s).
     pub h: f32,

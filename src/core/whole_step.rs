@@ -32,6 +32,7 @@ use crate::core::schedule::{OwnSubstepSystems, SubstepSchedule};
 /// [`crate::core::schedule::SubstepSchedule`]; results are the same bit for bit, so this is only for
 /// comparisons and for debugging a game system placed in the substeps.
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct WholeStep(pub bool);
 
 impl Default for WholeStep {

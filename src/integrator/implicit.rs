@@ -31,6 +31,7 @@ use crate::particles::Nodes;
 /// A plane n·x ≥ offset a node may not cross during the solve (a contact with a static or
 /// kinematic collider, moving with it over the substep).
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub(crate) struct ContactPlane {
     pub node: u32,
     pub normal: Vec3,
@@ -88,6 +89,7 @@ pub(crate) trait ImplicitElements {
 
 /// What one implicit substep did.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct ImplicitReport {
     /// Newton iterations taken.
     pub newton_iterations: u32,

@@ -64,6 +64,7 @@ use crate::particles::Nodes;
 #[derive(
     serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Hash, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub enum Integrator {
     /// Forward Euler. First order; energy grows every step. For teaching and comparison.
     ExplicitEuler,
@@ -170,6 +171,7 @@ impl Integrator {
 /// Read from a file (a snapshot), its settings are checked: a tolerance positive and finite,
 /// Newton iterations 1 to 1,000, conjugate-gradient iterations 1 to 100,000.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[serde(try_from = "ImplicitRecord")]
 #[require(ImplicitState)]
 pub struct ImplicitEuler {
@@ -214,6 +216,7 @@ pub struct ImplicitEuler {
 #[derive(
     serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Eq, Hash, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub enum ImplicitScheme {
     /// v₁ = v₀ + h a(x₁, v₁), x₁ = x₀ + h v₁. First order; damps every motion.
     #[default]
@@ -238,7 +241,9 @@ impl ImplicitScheme {
 /// What the implicit solve keeps from one step to the next for one body (the preconditioner's
 /// factor); added with [`ImplicitEuler`], nothing to set.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct ImplicitState {
+    #[cfg_attr(feature = "bevy", reflect(ignore))]
     pub(crate) factor: Option<skyline::SkylineCholesky>,
     /// (nodes, elements) the factor's pattern was built for; `None` before the first build.
     pub(crate) built_for: Option<(usize, usize)>,
@@ -399,6 +404,7 @@ pub(crate) fn follow_implicit_dial<M: Component>(
 
 /// Per-body override of the global [`Integrator`].
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct IntegratorOverride(pub Integrator);
 
 /// One explicit Euler step: both updates use the start-of-step state.

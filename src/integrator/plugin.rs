@@ -29,6 +29,7 @@ use crate::rigid::{
 #[derive(
     serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct ConstraintsActive(pub bool);
 
 impl ConstraintsActive {

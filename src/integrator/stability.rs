@@ -55,6 +55,7 @@ pub const MAX_LOCAL_SUBSTEPS: u32 = 256;
 #[derive(
     serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Hash, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub enum StabilityPolicy {
     /// The cheapest rescue that keeps the motion (see the module docs): local substeps for a
     /// spring system that needs few, BDF2 otherwise. The default.
@@ -160,6 +161,7 @@ impl StabilityPolicy {
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Hash,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[serde(try_from = "u32", into = "u32")]
 pub struct LocalSubsteps {
     count: u32,

@@ -17,6 +17,7 @@ use crate::core::quarantine::{Validate, validate_on_insert};
 /// [`JointImpulse`] (zeroed), and is reported once in a [`JointBroken`] message. Insert the joint
 /// again to mend it.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct JointBreakForce {
     /// The largest force it holds (N, ≥ 0).

@@ -14,6 +14,7 @@ use crate::rigid::{CenterOfMass, Rotation};
 /// How well the joints held in the last step. A resource, measured after each step while a
 /// joint exists (with [`crate::core::diagnostics::DiagnosticsSettings::energy`]).
 #[derive(Resource, Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct JointDiagnostics {
     /// Joints measured (those not quarantined, with both bodies present).
     pub joints: usize,

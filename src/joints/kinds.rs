@@ -78,6 +78,7 @@ fn unit(what: &'static str, axis: Vec3) -> Result<()> {
 /// The range a joint's free axis may move in: `min ≤ value ≤ max`, in rad for a hinge's
 /// turn, in m for a slider's offset or a distance joint's length.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct JointLimits {
     /// The smallest value (rad or m).
     pub min: f32,
@@ -116,6 +117,7 @@ impl JointLimits {
 /// [`MotorSpring`], as a spring–damper towards an angle. Solved in every pass before the
 /// joint's other rows, as Box2D solves its motors.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct AngularMotor {
     /// The relative angular velocity it drives towards (rad/s).
     pub target_velocity: f32,
@@ -131,6 +133,7 @@ pub struct AngularMotor {
 /// `target_velocity`, with at most `max_force`; with a [`MotorSpring`], as a spring–damper
 /// towards an offset.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct LinearMotor {
     /// The relative velocity along the axis it drives towards (m/s).
     pub target_velocity: f32,
@@ -145,6 +148,7 @@ pub struct LinearMotor {
 /// A motor's spring: it exerts `stiffness (target − value) + damping (target velocity −
 /// rate)`, within the motor's maximum, integrated implicitly (stable at any stiffness).
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct MotorSpring {
     /// The angle (rad) or offset (m) it pulls towards.
     pub target: f32,
@@ -210,6 +214,7 @@ fn validate_motor(target: f32, max: f32, what: &'static str) -> Result<()> {
 ///     .with_twist_limits(-30_f32.to_radians(), 30_f32.to_radians());
 /// ```
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(JointImpulse)]
 #[component(on_insert = joint_inserted::<Self>, on_discard = joint_discarded::<Self>)]
 pub struct SphericalJoint {
@@ -348,6 +353,7 @@ impl Validate for SphericalJoint {
 /// [`Self::new`] (precisely: where `b`'s rotation is `a`'s times the shortest arc from
 /// `axis_b` to `axis_a`).
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(JointImpulse)]
 #[component(on_insert = joint_inserted::<Self>, on_discard = joint_discarded::<Self>)]
 pub struct RevoluteJoint {
@@ -479,6 +485,7 @@ impl Validate for RevoluteJoint {
 /// `a`'s anchor along `a`'s axis; the slide along the axis is free, within its limits if it
 /// has them. The slide's offset is `b`'s anchor's distance from `a`'s along the axis (m).
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(JointImpulse)]
 #[component(on_insert = joint_inserted::<Self>, on_discard = joint_discarded::<Self>)]
 pub struct PrismaticJoint {
@@ -623,6 +630,7 @@ impl Validate for PrismaticJoint {
 /// A rope or a rod: the anchors stay between `limits.min` and `limits.max` apart (m); every
 /// turn is free. Equal limits make a rod, a zero minimum a rope.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(JointImpulse)]
 #[component(on_insert = joint_inserted::<Self>, on_discard = joint_discarded::<Self>)]
 pub struct DistanceJoint {
@@ -687,6 +695,7 @@ impl Validate for DistanceJoint {
 
 /// A weld: `b` keeps its anchor on `a`'s and its rotation relative to `a`.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(JointImpulse)]
 #[component(on_insert = joint_inserted::<Self>, on_discard = joint_discarded::<Self>)]
 pub struct FixedJoint {

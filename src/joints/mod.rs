@@ -95,6 +95,7 @@ use crate::core::quarantine::{Validate, validate_on_insert};
 
 /// The two sides of a joint: `a` (or the world when `None`) and `b`.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct JointBodies {
     /// The first body; `None` joins `b` to the world.
     pub a: Option<Entity>,
@@ -175,6 +176,7 @@ fn joint_discarded<T: Joint>(mut world: DeferredWorld, ctx: HookContext) {
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct JointImpulse {
     /// The locked rows' linear impulse at `b`'s anchor (N·s, world frame).
     pub linear: Vec3,
@@ -255,6 +257,7 @@ impl JointImpulse {
 /// takes only the rate at which such a spring closes a gap: it holds its whole load, so a
 /// load does not stretch it (see `docs/joints.md`, "Exact groups are not springs").
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct JointSettings {
     /// Frequency of the correcting spring (Hz), capped at a quarter of the substep rate.
     /// Zero or less: no correction of drift (velocities only).

@@ -19,6 +19,7 @@ use crate::core::error::{Result, finite, finite_vec};
 
 /// Uniform gravitational acceleration (m/s²). Default: (0, −9.81, 0).
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct Gravity(Vec3);
 
 impl Default for Gravity {
@@ -52,6 +53,7 @@ impl Gravity {
 #[derive(
     serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub enum Advection {
     /// x ← x + h u(x, t): the lecture's scheme, first order.
     #[default]
@@ -66,6 +68,11 @@ type FieldFn = dyn Fn(Vec3, f32) -> Vec3 + Send + Sync;
 
 /// A velocity field u(x, t) (m/s). Put it on an entity; tracers feel the sum of all fields.
 #[derive(serde::Serialize, serde::Deserialize, Component, Clone)]
+#[cfg_attr(
+    feature = "bevy",
+    derive(bevy_reflect::Reflect),
+    reflect(opaque, Component, Clone, Debug)
+)]
 pub enum VelocityField {
     /// The same velocity everywhere.
     Uniform(Vec3),

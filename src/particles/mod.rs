@@ -35,6 +35,7 @@ macro_rules! finite_vec_component {
     ($(#[$doc:meta])* $name:ident($ty:ty), $what:literal) => {
         $(#[$doc])*
         #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default)]
+        #[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
         #[component(on_insert = validate_on_insert::<Self>)]
         pub struct $name(pub $ty);
 
@@ -97,11 +98,13 @@ finite_vec_component!(
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct Force(pub Vec3A);
 
 /// Mass (kg), stored with its inverse. An infinite mass pins the body: forces don't move it,
 /// but a velocity you give it does (a kinematic particle).
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(Position, LinearVelocity, Force)]
 #[component(on_remove = quarantine_massless)]
 pub struct Mass {
@@ -202,6 +205,7 @@ impl Mass {
 
 /// Multiplies gravity for one body (dimensionless; 1 by default, 0 to float).
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct GravityScale(pub f32);
 
@@ -221,6 +225,7 @@ impl Validate for GravityScale {
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct LinearDamping(pub f32);
 
@@ -234,6 +239,7 @@ impl Validate for LinearDamping {
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(Position)]
 pub struct Tracer;
 

@@ -12,6 +12,7 @@ use crate::core::error::{Error, Result, finite_vec};
 ///
 /// Units as for particles: positions in m, velocities in m/s, masses in kg, forces in N.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct Nodes {
     pub(crate) x: Vec<Vec3A>,
     pub(crate) v: Vec<Vec3A>,

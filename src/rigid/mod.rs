@@ -66,6 +66,7 @@ use crate::particles::Position;
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(Position, Rotation)]
 #[cfg_attr(feature = "bevy", require(bevy_transform::components::Transform))]
 #[component(on_insert = mass::body_kind_changed)]
@@ -81,6 +82,7 @@ pub enum RigidBody {
 
 /// Orientation q, a unit quaternion from body to world frame.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct Rotation(pub Quat);
 
@@ -128,6 +130,7 @@ macro_rules! angular_vec {
     ($(#[$doc:meta])* $name:ident, $what:literal) => {
         $(#[$doc])*
         #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default)]
+        #[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
         #[component(on_insert = validate_on_insert::<Self>)]
         pub struct $name(pub Vec3A);
 
@@ -173,6 +176,7 @@ angular_vec!(
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct Torque(pub Vec3A);
 
 /// Centre of mass in the body's shape frame (m). The frame origin in the world is x − R c.
@@ -180,6 +184,7 @@ pub struct Torque(pub Vec3A);
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct CenterOfMass(pub Vec3);
 
@@ -193,6 +198,7 @@ impl Validate for CenterOfMass {
 /// (kg·m²) and principal frame F, with the inverse moments. Infinite moments (inverse 0)
 /// make a body that torques cannot turn.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(AngularMomentum, AngularVelocity, Torque, Rotation)]
 pub struct Inertia {
     principal: Vec3A,
@@ -355,6 +361,7 @@ fn unit(q: Quat) -> Quat {
 #[derive(
     serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub enum OrientationUpdate {
     /// Free-rotation splitting (the default): the kinetic energy Σ Lᵢ²/2Iᵢ is split about
     /// the middle moment I₂ into a turn about the fixed world L at |L|/I₂ and two spins
@@ -376,6 +383,7 @@ pub enum OrientationUpdate {
 
 /// Whether the renormalise set restores |q| = 1 every substep (default: on).
 #[derive(serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct Renormalization(pub bool);
 
 impl Default for Renormalization {
@@ -388,11 +396,13 @@ impl Default for Renormalization {
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct SkipRenormalization;
 
 /// A force applied at a point, every step until changed or removed: adds f to the force
 /// and (p − x) × f to the torque.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct ExternalForceAtPoint {
     /// Force (N, world frame).
@@ -413,6 +423,7 @@ impl Validate for ExternalForceAtPoint {
 /// A one-shot impulse J (N·s, world frame) at a point: Δv = J/m, ΔL = (p − x) × J at the
 /// next substep, then the impulse is reset to zero (like [`crate::particles::ExternalImpulse`]).
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct ExternalImpulseAtPoint {
     /// Impulse (N·s, world frame).
@@ -434,6 +445,7 @@ impl Validate for ExternalImpulseAtPoint {
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct AngularDamping(pub f32);
 
@@ -446,6 +458,7 @@ impl Validate for AngularDamping {
 /// A pose a kinematic body should reach by the end of each step: hooke sets its velocities
 /// to (target − x)/dt and the rotation difference over dt.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_on_insert::<Self>)]
 pub struct KinematicTarget {
     /// Target centre-of-mass position (m).

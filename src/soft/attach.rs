@@ -50,11 +50,13 @@ pub const MAX_ATTACHED_NODES: usize = 128;
 /// module docs). Pinned nodes are skipped; a missing or quarantined body leaves its nodes
 /// free until it is back.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct NodeAttachments {
     links: Vec<Link>,
 }
 
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 struct Link {
     body: Entity,
     nodes: Vec<u32>,
@@ -64,6 +66,7 @@ struct Link {
     impulse: Vec3,
     h: f32,
     /// W_soft for the nodes, kept while the factor it came from is held.
+    #[cfg_attr(feature = "bevy", reflect(ignore))]
     response: Option<(u64, f32, DMatrix<f64>)>,
 }
 

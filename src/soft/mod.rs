@@ -59,6 +59,7 @@ use crate::particles::Nodes;
 
 /// The Lamé parameters μ (shear modulus) and λ (Pa).
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct Lame {
     /// μ (Pa).
     pub mu: f32,
@@ -71,6 +72,7 @@ pub struct Lame {
 /// Read from a file (a snapshot) it is checked as [`Material::new`] checks its input.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq)]
 #[serde(try_from = "MaterialRecord")]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct Material {
     young: f32,
     poisson: f32,
@@ -172,6 +174,7 @@ impl Material {
 
 /// What a soft body's last force evaluation found: elastic energy, volume and inversion.
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct SoftBodyStats {
     /// Elastic energy Σ V Ψ(F) (J).
     pub elastic_energy: f64,
@@ -189,6 +192,7 @@ pub struct SoftBodyStats {
 /// fields, every integrator and the quarantine act on its nodes as on any mesh. Spawn both
 /// with [`SoftBody::build`].
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(Nodes, SoftStability)]
 pub struct SoftBody {
     tets: Vec<[u32; 4]>,

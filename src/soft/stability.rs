@@ -41,6 +41,7 @@ pub const LOCAL_SUBSTEPS_CHEAPER_UP_TO: u32 = 12;
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct SoftStability {
     /// The largest substep (s) explicit integration is sure to be stable at.
     pub critical_step: f32,

@@ -164,6 +164,7 @@ fn cross_matrix(w: Vec3) -> Mat3 {
 /// How a soft body's material measures strain: the dial between cost and fidelity. See the
 /// [module docs](super).
 #[derive(serde::Serialize, serde::Deserialize, Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub enum StrainModel {
     /// Green's strain with the linear stress (St. Venant–Kirchhoff): rotation-exact, stiffens
     /// in stretch, and collapses under strong compression (no resistance to inversion).

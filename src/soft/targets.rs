@@ -15,6 +15,7 @@ use crate::particles::Nodes;
 /// (target − x)/dt, so it arrives at the end of the step under any integrator, explicit or
 /// implicit. Removing the component, or a node's target, gives the node its mass back.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, PartialEq, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_remove = release_all)]
 pub struct NodeTargets {
     targets: Vec<(u32, Vec3)>,

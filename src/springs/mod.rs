@@ -93,6 +93,7 @@ pub fn spring_energy(xa: Vec3A, xb: Vec3A, rest: f32, k: f32) -> f64 {
 /// Build it with [`Spring::new`] or [`Spring::from_hooke`] and spawn it like any component.
 /// If an endpoint is despawned, the spring is despawned at the next step.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[component(on_insert = validate_spring)]
 pub struct Spring {
     a: Entity,
@@ -288,6 +289,7 @@ impl SpringReading {
 
 /// Springs between the [`Nodes`] of the same entity, as parallel arrays (Hooke form).
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(SpringStability)]
 pub struct SpringNetwork {
     pub(crate) ends: Vec<[u32; 2]>,

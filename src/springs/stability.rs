@@ -47,6 +47,7 @@ pub const LOCAL_SUBSTEPS_CHEAPER_UP_TO: u32 = 64;
 #[derive(
     serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 pub struct SpringStability {
     /// The largest stable substep h_crit (s); infinite for springs between pinned nodes only.
     pub critical_step: f32,
@@ -60,6 +61,7 @@ pub struct SpringStability {
 #[derive(
     serde::Serialize, serde::Deserialize, Resource, Debug, Clone, Copy, PartialEq, Default,
 )]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct EntitySpringStability {
     /// The largest stable substep over all [`Spring`] entities (s).
     pub critical_step: f32,

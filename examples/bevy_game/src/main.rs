@@ -3,16 +3,19 @@
 //! - **Left click**: throw a steel ball from the camera towards the cursor.
 //! - **Space**: throw one straight at the stack.
 //! - **R**: rebuild the stack.
+//! - **G**: show or hide the debug view (colliders, contacts, velocities).
 //! - **Arrow keys**: orbit the camera.
 //!
 //! ```sh
 //! cargo run --release --manifest-path examples/bevy_game/Cargo.toml   # add --ignore-rust-version on Rust < 1.97.1
+//! cargo run --release --manifest-path examples/bevy_game/Cargo.toml -- --debug   # debug view on from the start
 //! ```
 
 // Both preludes glob-imported, warnings denied: hooke's names must not clash with Bevy's.
 #![deny(warnings)]
 
 use bevy::prelude::*;
+use hooke::bevy::{PhysicsDebugPlugin, PhysicsGizmos};
 use hooke::prelude::*;
 
 /// Half extent of a crate (m).
@@ -48,7 +51,17 @@ fn main() {
             }),
             ..default()
         }))
-        .add_plugins(PhysicsPlugins)
+        .add_plugins((PhysicsPlugins, PhysicsDebugPlugin))
+        .insert_gizmo_config(
+            PhysicsGizmos {
+                velocities: Some(Color::srgb(0.2, 0.4, 1.0)),
+                ..default()
+            },
+            GizmoConfig {
+                enabled: std::env::args().any(|a| a == "--debug"),
+                ..default()
+            },
+        )
         .insert_resource(Time::<Fixed>::from_hz(60.0))
         .insert_resource(Look {
             yaw: 0.0,
@@ -56,7 +69,7 @@ fn main() {
             distance: 12.0,
         })
         .add_systems(Startup, setup)
-        .add_systems(Update, (orbit_camera, throw, rebuild))
+        .add_systems(Update, (orbit_camera, throw, rebuild, toggle_debug_view))
         .run();
 }
 
@@ -91,7 +104,7 @@ fn setup(
     commands.spawn((Camera3d::default(), Transform::default()));
     commands.spawn((
         Text::new(
-            "left click: throw at the cursor  |  space: throw  |  R: rebuild  |  arrows: orbit",
+            "left click: throw at the cursor  |  space: throw  |  R: rebuild  |  G: debug view  |  arrows: orbit",
         ),
         Node {
             position_type: PositionType::Absolute,
@@ -199,4 +212,11 @@ fn rebuild(
         spawn_stack(&mut commands, &assets)?;
     }
     Ok(())
+}
+
+fn toggle_debug_view(keys: Res<ButtonInput<KeyCode>>, mut store: ResMut<GizmoConfigStore>) {
+    if keys.just_pressed(KeyCode::KeyG) {
+        let (config, _) = store.config_mut::<PhysicsGizmos>();
+        config.enabled = !config.enabled;
+    }
 }

@@ -223,10 +223,13 @@ impl PairState {
 /// Every pair of colliders whose boxes overlap, with their contact manifolds. A resource:
 /// read it after a step to see what touches what.
 #[derive(Resource, Default)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Resource))]
 pub struct Contacts {
+    #[cfg_attr(feature = "bevy", reflect(ignore))]
     pub(crate) pairs: PairTable,
     /// The pairs the narrow phase found points for this step (sensors left out), in the
     /// broad phase's order: the solver's preparation takes them from here.
+    #[cfg_attr(feature = "bevy", reflect(ignore))]
     pub(crate) active: Vec<ActivePair>,
     pub(crate) step: u64,
     /// Touching pairs inside islands woken this step: the broad phase skipped them while

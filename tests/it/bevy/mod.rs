@@ -3,5 +3,6 @@
 mod app;
 mod debug_view;
 mod preludes;
+mod reflection;
 mod required_components_spawning;
 mod teleports_under_interpolation;
