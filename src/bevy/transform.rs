@@ -8,6 +8,12 @@
 //! step. That comparison of values, not of change ticks, is what makes a write through
 //! `get_mut`, a `commands.insert` and an interpolated frame all behave the same.
 //!
+//! A kinematic body's written `Transform` is not a teleport but where it should be by the end
+//! of the next step: hooke gives it a [`KinematicTarget`] for that step, so it moves there
+//! with the velocity that takes it there and carries what rests on it (a platform moved by
+//! its `Transform` every frame). After the step the target is taken off again and its
+//! velocities zeroed: it stands still until the next write.
+//!
 //! On first sight a body's `Transform` wins, unless it is the identity while the physics
 //! pose is not (a body spawned with `Position`): then the physics pose wins. Scale is left
 //! alone and does not scale colliders.
@@ -24,7 +30,7 @@ use super::{AppSchedule, PhysicsAppSystems};
 use crate::collision::{Collider, ColliderOf, ColliderOffset};
 use crate::core::quarantine::Quarantined;
 use crate::particles::{LinearVelocity, Mass, Position};
-use crate::rigid::{CenterOfMass, RigidBody, Rotation};
+use crate::rigid::{AngularVelocity, CenterOfMass, KinematicTarget, RigidBody, Rotation};
 
 /// Reads written `Transform`s before each step and writes poses back after it.
 #[derive(Debug, Default, Clone, Copy)]
@@ -40,7 +46,7 @@ impl Plugin for PhysicsTransformPlugin {
             schedule,
             (
                 (read_transforms, read_child_offsets).in_set(PhysicsAppSystems::ReadTransforms),
-                write_transforms.in_set(PhysicsAppSystems::Writeback),
+                (write_transforms, release_transform_targets).in_set(PhysicsAppSystems::Writeback),
             ),
         );
         app.add_observer(place_on_spawn);
@@ -71,6 +77,7 @@ type BodyPose<'a> = (
     Option<&'a Rotation>,
     Option<&'a CenterOfMass>,
     Option<&'a mut PoseHistory>,
+    Option<&'a RigidBody>,
 );
 type Posed = (
     Or<(With<RigidBody>, With<Collider>, With<Mass>)>,
@@ -85,7 +92,7 @@ fn read_transforms(
     mut bodies: Query<BodyPose, Posed>,
     globals: Query<&GlobalTransform>,
 ) {
-    for (e, mut t, parent, synced, x, q, com, history) in &mut bodies {
+    for (e, mut t, parent, synced, x, q, com, history, body) in &mut bodies {
         if synced.is_some_and(|s| s.matches(&t)) {
             continue;
         }
@@ -110,6 +117,18 @@ fn read_transforms(
         let rotation = (pr * t.rotation).normalize();
         let origin = pt + pr * t.translation;
         let centre = origin + rotation * c;
+        if synced.is_some() && body == Some(&RigidBody::Kinematic) {
+            // Moved, not teleported: reached by the end of the next step.
+            commands.entity(e).insert((
+                KinematicTarget {
+                    position: centre,
+                    rotation,
+                },
+                TargetFromTransform,
+                SyncedTransform::of(&t),
+            ));
+            continue;
+        }
         if let Some(mut h) = history {
             h.reset(t.translation, t.rotation);
         }
@@ -234,5 +253,29 @@ fn write_transforms(
                 commands.entity(e).insert(SyncedTransform::of(&t));
             }
         }
+    }
+}
+
+/// Marks a [`KinematicTarget`] hooke set from a written `Transform`, for one step.
+#[derive(Component, Debug, Clone, Copy)]
+pub(crate) struct TargetFromTransform;
+
+/// After the step: a kinematic body moved by its `Transform` stops where it got to, until the
+/// next write.
+fn release_transform_targets(
+    mut commands: Commands,
+    mut bodies: Query<
+        (Entity, &mut LinearVelocity, Option<&mut AngularVelocity>),
+        With<TargetFromTransform>,
+    >,
+) {
+    for (e, mut v, w) in &mut bodies {
+        v.0 = Vec3A::ZERO;
+        if let Some(mut w) = w {
+            w.0 = Vec3A::ZERO;
+        }
+        commands
+            .entity(e)
+            .remove::<(KinematicTarget, TargetFromTransform)>();
     }
 }

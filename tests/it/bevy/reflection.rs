@@ -34,6 +34,7 @@ const INTERNAL: &[&str] = &[
     "hooke::collision::coincident::RecentSpawns",
     "hooke::collision::attach::OwnShape",
     "hooke::joints::plugin::Scratch",
+    "hooke::bevy::transform::TargetFromTransform",
     "hooke::rigid::mass::ComputedMass",
 ];
 
