@@ -59,6 +59,12 @@ fn main() {
             },
             GizmoConfig {
                 enabled: std::env::args().any(|a| a == "--debug"),
+                // Drawn over the meshes, two pixels wide: the outlines lie on the surfaces.
+                depth_bias: -1.0,
+                line: GizmoLineConfig {
+                    width: 2.0,
+                    ..default()
+                },
                 ..default()
             },
         )
