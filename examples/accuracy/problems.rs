@@ -248,7 +248,7 @@ pub fn pendulum(quick: bool) -> hooke::Result<Problem> {
                     Observed,
                 ))
                 .id();
-            Spring::from_hooke(anchor, bob, l as f32, k as f32, 0.0)?.spawn(w)?;
+            Spring::new(anchor, bob, l as f32, k as f32, 0.0)?.spawn(w)?;
             Ok(())
         },
         observed_positions,

@@ -223,7 +223,7 @@ fn cloth_springs(cfg: &Config, n: usize) {
         .iter()
         .map(|&[a, b]| {
             let r = (nodes.positions()[b as usize] - nodes.positions()[a as usize]).length();
-            Spring::from_hooke(ids[a as usize], ids[b as usize], r, 8.0, 0.01).unwrap()
+            Spring::new(ids[a as usize], ids[b as usize], r, 8.0, 0.01).unwrap()
         })
         .collect();
     world.spawn_batch(batch);

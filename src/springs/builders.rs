@@ -199,12 +199,12 @@ impl ChainBuilder {
             ..Default::default()
         };
         for w in chain.nodes.windows(2) {
-            let s = Spring::from_hooke(w[0], w[1], seg, k, c)?;
+            let s = Spring::new(w[0], w[1], seg, k, c)?;
             chain.springs.push(world.spawn_one(s));
         }
         if kb > 0.0 {
             for w in chain.nodes.windows(3) {
-                let s = Spring::from_hooke(w[0], w[2], 2.0 * seg, kb, 0.0)?;
+                let s = Spring::new(w[0], w[2], 2.0 * seg, kb, 0.0)?;
                 chain.bend_springs.push(world.spawn_one(s));
             }
         }

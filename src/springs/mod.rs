@@ -14,7 +14,7 @@
 //! f_p = [ k (l − r) + c (v_q − v_p)·d̂ ] d̂,   k = k_s / r (N/m),   c = k_d / r (N·s/m)
 //! ```
 //!
-//! [`Spring::new`] takes the lecture's (k_s, k_d); [`Spring::from_hooke`] takes (k, c) and
+//! [`Spring::new`] takes the lecture's (k_s, k_d); [`Spring::new`] takes (k, c) and
 //! allows r = 0. When the endpoints coincide the direction is undefined and the force is
 //! zero (for r = 0 that is also the limit). The potential energy is ½ k (l − r)².
 //!
@@ -90,7 +90,7 @@ pub fn spring_energy(xa: Vec3A, xb: Vec3A, rest: f32, k: f32) -> f64 {
 
 /// A spring entity between bodies `a` and `b` (entities with a [`Position`]).
 ///
-/// Build it with [`Spring::new`] or [`Spring::from_hooke`] and spawn it like any component.
+/// Build it with [`Spring::new`] or [`Spring::new`] and spawn it like any component.
 /// If an endpoint is despawned, the spring is despawned at the next step.
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
@@ -111,25 +111,12 @@ impl Spring {
         [&mut self.a, &mut self.b]
     }
 
-    /// The lecture's spring: rest length `r` (m, > 0), `ks` (N per unit strain) and `kd`
-    /// (N·s per unit strain rate).
-    ///
-    /// # Errors
-    /// [`Error::SelfSpring`], [`Error::NotPositive`] for r ≤ 0, [`Error::Negative`] or
-    /// [`Error::NonFinite`] for bad coefficients.
-    pub fn new(a: Entity, b: Entity, r: f32, ks: f32, kd: f32) -> Result<Self> {
-        let r = positive("rest length", r)?;
-        let ks = non_negative("spring stiffness", ks)?;
-        let kd = non_negative("spring damping", kd)?;
-        Self::from_hooke(a, b, r, ks / r, kd / r)
-    }
-
-    /// A spring in Hooke form: rest length `r` (m, ≥ 0), stiffness `k` (N/m), damping `c`
-    /// (N·s/m).
+    /// A spring of rest length `r` (m, ≥ 0), stiffness `k` (N/m) and damping `c` (N·s/m):
+    /// force k (l − r) + c l̇ along the line between its ends.
     ///
     /// # Errors
     /// [`Error::SelfSpring`], [`Error::Negative`] or [`Error::NonFinite`].
-    pub fn from_hooke(a: Entity, b: Entity, r: f32, k: f32, c: f32) -> Result<Self> {
+    pub fn new(a: Entity, b: Entity, r: f32, k: f32, c: f32) -> Result<Self> {
         if a == b {
             return Err(Error::SelfSpring(a));
         }
@@ -142,6 +129,19 @@ impl Spring {
             anchor_a: Vec3::ZERO,
             anchor_b: Vec3::ZERO,
         })
+    }
+
+    /// The lecture's spring in strain form: rest length `r` (m, > 0), `ks` (N per unit
+    /// strain) and `kd` (N·s per unit strain rate), that is k = ks / r and c = kd / r.
+    ///
+    /// # Errors
+    /// [`Error::SelfSpring`], [`Error::NotPositive`] for r ≤ 0, [`Error::Negative`] or
+    /// [`Error::NonFinite`] for bad coefficients.
+    pub fn from_strain(a: Entity, b: Entity, r: f32, ks: f32, kd: f32) -> Result<Self> {
+        let r = positive("rest length", r)?;
+        let ks = non_negative("spring stiffness", ks)?;
+        let kd = non_negative("spring damping", kd)?;
+        Self::new(a, b, r, ks / r, kd / r)
     }
 
     /// Attaches the ends at points of the bodies (m, relative to each body's centre of mass
@@ -222,7 +222,7 @@ impl Spring {
     }
 
     fn check(&self) -> Result<()> {
-        Self::from_hooke(
+        Self::new(
             self.a,
             self.b,
             self.rest_length,

@@ -38,7 +38,7 @@ pub fn oscillator(world: &mut World, m: f32, k: f32, c: f32, x0: f32) -> Result<
     let body = world
         .spawn(ParticleBundle::new(Vec3::new(x0, 0.0, 0.0), Vec3::ZERO, m)?)
         .id();
-    Spring::from_hooke(anchor, body, 0.0, k, c)?.spawn(world)?;
+    Spring::new(anchor, body, 0.0, k, c)?.spawn(world)?;
     Ok(body)
 }
 
@@ -584,7 +584,7 @@ pub fn pinned_beam(
 /// own mode is 1000 rad/s, past the default substep's explicit limit. Returns the bob.
 ///
 /// # Errors
-/// As [`Spring::from_hooke`] for a bad `k`.
+/// As [`Spring::new`] for a bad `k`.
 pub fn stiff_rod_pendulum(world: &mut World, k: f32) -> Result<Entity> {
     let pin = world.spawn(ParticleBundle::pinned(Vec3::ZERO)?).id();
     let bob = world
@@ -594,7 +594,7 @@ pub fn stiff_rod_pendulum(world: &mut World, k: f32) -> Result<Entity> {
             1.0,
         )?)
         .id();
-    Spring::from_hooke(pin, bob, 1.0, k, 0.0)?.spawn(world)?;
+    Spring::new(pin, bob, 1.0, k, 0.0)?.spawn(world)?;
     Ok(bob)
 }
 
@@ -605,7 +605,7 @@ pub fn stiff_rod_pendulum(world: &mut World, k: f32) -> Result<Entity> {
 /// the default substep's explicit limit. Returns the top.
 ///
 /// # Errors
-/// As [`Spring::from_hooke`] for a bad `k`, and a non-finite `spin`.
+/// As [`Spring::new`] for a bad `k`, and a non-finite `spin`.
 pub fn top_on_a_pivot(world: &mut World, k: f32, spin: f32) -> Result<Entity> {
     use crate::rigid::{Inertia, MassProperties, RigidBodyBundle};
     let inertia = Inertia::diagonal(0.02, 0.01, 0.02)?;
@@ -619,7 +619,7 @@ pub fn top_on_a_pivot(world: &mut World, k: f32, spin: f32) -> Result<Entity> {
                 .with_angular_velocity(tilt * Vec3::Y * spin)?,
         )
         .id();
-    Spring::from_hooke(pin, top, 0.0, k, 0.0)?
+    Spring::new(pin, top, 0.0, k, 0.0)?
         .with_anchors(Vec3::ZERO, Vec3::new(0.0, -0.3, 0.0))?
         .spawn(world)?;
     Ok(top)

@@ -146,7 +146,7 @@ pub(super) fn spawn(
                 Some(r) => *r,
                 None => (xa + turn(ea) * *anchor_a).distance(xb + turn(eb) * *anchor_b),
             };
-            let spring = Spring::from_hooke(ea, eb, rest, *stiffness, *damping)?
+            let spring = Spring::new(ea, eb, rest, *stiffness, *damping)?
                 .with_anchors(*anchor_a, *anchor_b)?;
             vec![world.spawn(spring).id()]
         }

@@ -418,7 +418,7 @@ fn box_hanging_from_a_corner_spring_settles_at_the_static_equilibrium() {
         ))
         .id();
     let (k, rest) = (3000.0, 0.5);
-    Spring::from_hooke(anchor, body, rest, k, 40.0)
+    Spring::new(anchor, body, rest, k, 40.0)
         .unwrap()
         .with_anchors(Vec3::ZERO, half)
         .unwrap()

@@ -88,56 +88,56 @@ fn spring_constructors_reject_bad_values() {
         .spawn(ParticleBundle::new(Vec3::X, Vec3::ZERO, 1.0).unwrap())
         .id();
     assert_eq!(
-        Spring::new(a, a, 1.0, 1.0, 0.0).unwrap_err(),
+        Spring::from_strain(a, a, 1.0, 1.0, 0.0).unwrap_err(),
         Error::SelfSpring(a)
     );
     assert!(matches!(
-        Spring::new(a, b, 0.0, 1.0, 0.0),
+        Spring::from_strain(a, b, 0.0, 1.0, 0.0),
         Err(Error::NotPositive {
             what: "rest length",
             ..
         })
     ));
     assert!(matches!(
-        Spring::new(a, b, -1.0, 1.0, 0.0),
+        Spring::from_strain(a, b, -1.0, 1.0, 0.0),
         Err(Error::NotPositive { .. })
     ));
     assert!(matches!(
-        Spring::from_hooke(a, b, -1.0, 1.0, 0.0),
+        Spring::new(a, b, -1.0, 1.0, 0.0),
         Err(Error::Negative {
             what: "rest length",
             ..
         })
     ));
     assert!(matches!(
-        Spring::from_hooke(a, b, 1.0, -1.0, 0.0),
+        Spring::new(a, b, 1.0, -1.0, 0.0),
         Err(Error::Negative {
             what: "spring stiffness",
             ..
         })
     ));
     assert!(matches!(
-        Spring::from_hooke(a, b, 1.0, 1.0, -1.0),
+        Spring::new(a, b, 1.0, 1.0, -1.0),
         Err(Error::Negative {
             what: "spring damping",
             ..
         })
     ));
     assert!(matches!(
-        Spring::from_hooke(a, b, f32::NAN, 1.0, 0.0),
+        Spring::new(a, b, f32::NAN, 1.0, 0.0),
         Err(Error::NonFinite { .. })
     ));
     assert!(
-        Spring::from_hooke(a, b, 0.0, 1.0, 0.0).is_ok(),
+        Spring::new(a, b, 0.0, 1.0, 0.0).is_ok(),
         "zero-length springs are allowed"
     );
 
     let gone = world.spawn_empty().id();
     world.despawn(gone);
-    let s = Spring::from_hooke(a, gone, 1.0, 1.0, 0.0).unwrap();
+    let s = Spring::new(a, gone, 1.0, 1.0, 0.0).unwrap();
     assert_eq!(s.spawn(&mut world).unwrap_err(), Error::MissingEntity(gone));
     let not_a_body = world.spawn_empty().id();
-    let s = Spring::from_hooke(a, not_a_body, 1.0, 1.0, 0.0).unwrap();
+    let s = Spring::new(a, not_a_body, 1.0, 1.0, 0.0).unwrap();
     assert_eq!(
         s.spawn(&mut world).unwrap_err(),
         Error::MissingEntity(not_a_body)
@@ -253,7 +253,7 @@ fn spring_inserted_to_a_missing_entity_is_quarantined() {
     let gone = world.spawn_empty().id();
     world.despawn(gone);
     let s = world
-        .spawn(Spring::from_hooke(a, gone, 1.0, 1.0, 0.0).unwrap())
+        .spawn(Spring::new(a, gone, 1.0, 1.0, 0.0).unwrap())
         .id();
     world.flush();
     assert_eq!(

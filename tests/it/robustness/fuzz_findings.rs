@@ -107,7 +107,7 @@ fn springs_restored_before_their_ends_are_not_quarantined() {
         .spawn(ParticleBundle::new(Vec3::X, Vec3::ZERO, 1.0).unwrap())
         .id();
     let ds = world
-        .spawn(Spring::new(d1, d2, 1.0, 10.0, 0.0).unwrap())
+        .spawn(Spring::from_strain(d1, d2, 1.0, 10.0, 0.0).unwrap())
         .id();
     for e in [ds, d1, d2] {
         world.despawn(e);
@@ -120,7 +120,7 @@ fn springs_restored_before_their_ends_are_not_quarantined() {
         .id()
     };
     let (a, b) = (end(0.0, &mut world), end(1.2, &mut world));
-    world.spawn(Spring::new(a, b, 1.0, 50.0, 0.1).unwrap());
+    world.spawn(Spring::from_strain(a, b, 1.0, 50.0, 0.1).unwrap());
     world.step_physics();
     let snapshot = Snapshot::capture(&world).unwrap();
     let mut copy = World::new();
@@ -151,7 +151,7 @@ fn energies_of_large_finite_states_are_finite() {
     let b = world
         .spawn(ParticleBundle::pinned(Vec3::new(1e4, 0.0, 0.0)).unwrap())
         .id();
-    Spring::from_hooke(a, b, 1.0, 1e33, 0.0)
+    Spring::new(a, b, 1.0, 1e33, 0.0)
         .unwrap()
         .spawn(&mut world)
         .unwrap();

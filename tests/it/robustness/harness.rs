@@ -110,10 +110,12 @@ fn constructors(
     call(t, || hooke::particles::Gravity::new(u));
     call(t, || VelocityField::uniform(u));
     call(t, || VelocityField::vortex(u, v, a));
+    call(t, || Spring::from_strain(e, f, a, b, c));
     call(t, || Spring::new(e, f, a, b, c));
-    call(t, || Spring::from_hooke(e, f, a, b, c));
-    call(t, || Spring::new(e, e, 1.0, 1.0, 0.0));
-    call(t, || Spring::new(e, f, 1.0, 1.0, 0.0)?.with_anchors(u, v));
+    call(t, || Spring::from_strain(e, e, 1.0, 1.0, 0.0));
+    call(t, || {
+        Spring::from_strain(e, f, 1.0, 1.0, 0.0)?.with_anchors(u, v)
+    });
     if let Some(col) = call(t, || Collider::ball(a)) {
         prop_assert!(a > 0.0 && a.is_finite(), "ball({a}) accepted");
         let _ = col;

@@ -309,7 +309,7 @@ pub fn apply(world: &mut World, all: &[Entity], m: &Meddle) {
         }
         Meddle::Respring(_, a, b) => {
             if let (Some(a), Some(b)) = (pick(a), pick(b))
-                && let Ok(spring) = Spring::from_hooke(a, b, 1.0, 100.0, 1.0)
+                && let Ok(spring) = Spring::new(a, b, 1.0, 100.0, 1.0)
                 && let Ok(mut r) = world.get_entity_mut(e)
             {
                 r.insert(spring);

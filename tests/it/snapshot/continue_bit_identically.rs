@@ -410,7 +410,7 @@ fn springs_in_two_tables_continue_bit_identically() {
             let end = *rope.nodes.last().unwrap();
             // Parented to the rope's first node (any captured entity would do).
             let holder = rope.nodes[0];
-            let spring = Spring::from_hooke(end, crate_, 1.0, 500.0, 1.0).unwrap();
+            let spring = Spring::new(end, crate_, 1.0, 500.0, 1.0).unwrap();
             w.spawn((spring, ChildOf(holder)));
         },
         nothing,

@@ -17,7 +17,7 @@ fn a_pure_damper_and_a_soft_door_spring_pushed_hard_are_not_quarantined() {
         let edge = w
             .spawn(ParticleBundle::new(Vec3::X, Vec3::new(10.0, 0.0, 0.0), 1.0).unwrap())
             .id();
-        Spring::from_hooke(hinge, edge, 1.0, k, c)
+        Spring::new(hinge, edge, 1.0, k, c)
             .unwrap()
             .spawn(&mut w)
             .unwrap();
@@ -43,7 +43,7 @@ fn a_spring_stretched_past_the_guard_is_still_caught() {
     let end = w
         .spawn(ParticleBundle::new(Vec3::new(0.01, 0.0, 0.0), Vec3::ZERO, 1.0).unwrap())
         .id();
-    Spring::from_hooke(pin, end, 0.01, 10.0, 1.0)
+    Spring::new(pin, end, 0.01, 10.0, 1.0)
         .unwrap()
         .spawn(&mut w)
         .unwrap();

@@ -59,7 +59,7 @@ fn zero_length_and_coincident_springs_give_finite_forces() {
     let b = world
         .spawn(ParticleBundle::new(Vec3::ONE, Vec3::ZERO, 1.0).unwrap())
         .id();
-    Spring::from_hooke(a, b, 0.0, 1e4, 10.0)
+    Spring::new(a, b, 0.0, 1e4, 10.0)
         .unwrap()
         .spawn(&mut world)
         .unwrap();

@@ -221,7 +221,7 @@ fn a_rigid_box_on_a_stiff_spring_at_its_centre_bobs_about_the_static_stretch() {
     let body = w
         .spawn(box_body(10.0, Vec3::splat(0.1), Vec3::new(0.0, -1.0, 0.0)))
         .id();
-    Spring::from_hooke(pin, body, 1.0, 3.6e6, 0.0)
+    Spring::new(pin, body, 1.0, 3.6e6, 0.0)
         .unwrap()
         .spawn(&mut w)
         .unwrap();
@@ -270,7 +270,7 @@ fn a_box_hung_off_centre_by_a_stiff_spring_swings_without_gaining_energy() {
         ))
         .id();
     let corner = Vec3::new(0.4, 0.1, 0.0);
-    let spring = Spring::from_hooke(pin, body, 1.0, 1e6, 50.0)
+    let spring = Spring::new(pin, body, 1.0, 1e6, 50.0)
         .unwrap()
         .with_anchors(Vec3::ZERO, corner)
         .unwrap()

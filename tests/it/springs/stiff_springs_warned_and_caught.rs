@@ -225,7 +225,7 @@ fn torn_spring(w: &mut World) -> (Entity, Entity, Entity) {
     let ball = w
         .spawn(ParticleBundle::new(Vec3::new(0.0, -150.0, 0.0), Vec3::ZERO, 1.0).unwrap())
         .id();
-    let spring = hooke::springs::Spring::from_hooke(hook, ball, 1.0, 10.0, 0.0)
+    let spring = hooke::springs::Spring::new(hook, ball, 1.0, 10.0, 0.0)
         .unwrap()
         .spawn(w)
         .unwrap();
