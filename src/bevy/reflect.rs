@@ -91,6 +91,12 @@ pub(super) fn register_types(app: &mut App) {
         crate::collision::Restitution,
         crate::collision::RestitutionThreshold,
         crate::collision::Sensor,
+        crate::collision::RayCaster,
+        crate::collision::RayHits,
+        crate::collision::ShapeCaster,
+        crate::collision::ShapeHits,
+        crate::collision::QueryFilter,
+        crate::collision::Hit,
         // Joints.
         crate::joints::AngularMotor,
         crate::joints::DistanceJoint,

@@ -59,6 +59,7 @@
 
 mod attach;
 pub(crate) mod broad_phase;
+mod casters;
 pub mod coincident;
 pub(crate) mod lanes;
 pub(crate) mod narrow_phase;
@@ -173,6 +174,7 @@ pub(crate) fn restore_broad_phase(
         }
     }
 }
+pub use casters::{RayCaster, RayHits, ShapeCaster, ShapeHits};
 pub use query::{Hit, Projection, QueryFilter, SpatialQuery};
 
 use bevy_ecs::prelude::*;

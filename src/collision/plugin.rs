@@ -53,6 +53,17 @@ impl WorldPlugin for CollisionPlugin {
         world.add_observer(super::coincident::separate_coincident_spawns);
         world.add_observer(super::attach::on_child_of_discarded);
         world.add_observer(super::attach::on_child_of_inserted);
+        // Casters after the step's poses are final (and child colliders placed).
+        add_own_systems(
+            world,
+            PhysicsSchedule,
+            (
+                super::casters::update_ray_hits.run_if(any_with_component::<super::RayCaster>),
+                super::casters::update_shape_hits.run_if(any_with_component::<super::ShapeCaster>),
+            )
+                .after(super::attach::place_attached_colliders)
+                .in_set(crate::core::schedule::FinishSystems::Writeback),
+        );
         add_own_systems(
             world,
             PhysicsSchedule,

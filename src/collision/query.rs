@@ -18,6 +18,7 @@ use crate::rigid::{CenterOfMass, Rotation};
 
 /// Which colliders a query sees.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct QueryFilter {
     /// Only colliders whose memberships meet this mask.
     pub mask: u32,
@@ -50,6 +51,7 @@ impl QueryFilter {
 
 /// A ray or shape cast hit.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect))]
 pub struct Hit {
     /// The collider hit.
     pub entity: Entity,
@@ -124,11 +126,159 @@ impl SpatialQuery<'_, '_> {
         &'a self,
         filter: &'a QueryFilter,
     ) -> impl Iterator<Item = bevy_ecs::query::QueryItem<'a, 'a, QueryCollider<'static>>> + 'a {
+        self.candidates_where(filter, &|_| true)
+    }
+
+    /// The colliders `filter` lets through and `predicate` accepts.
+    fn candidates_where<'a>(
+        &'a self,
+        filter: &'a QueryFilter,
+        predicate: &'a dyn Fn(Entity) -> bool,
+    ) -> impl Iterator<Item = bevy_ecs::query::QueryItem<'a, 'a, QueryCollider<'static>>> + 'a {
         self.colliders.iter().filter(move |c| {
             c.5.memberships & filter.mask != 0
                 && (filter.include_sensors || !c.7)
                 && !filter.exclude.contains(&c.0)
+                && predicate(c.0)
         })
+    }
+
+    /// Every collider a ray from `origin` along `direction` hits within `max_distance` (m)
+    /// and `predicate` accepts, nearest first (ties by entity), at most `max_hits`: one hit
+    /// per collider, where the ray enters it (distance 0 for a ray starting inside).
+    #[must_use]
+    pub fn ray_hits(
+        &self,
+        origin: Vec3,
+        direction: Vec3,
+        max_distance: f32,
+        max_hits: usize,
+        filter: &QueryFilter,
+        predicate: &dyn Fn(Entity) -> bool,
+    ) -> Vec<Hit> {
+        let Some(dir) = direction.try_normalize() else {
+            return Vec::new();
+        };
+        if !(origin.is_finite() && max_distance >= 0.0) {
+            return Vec::new();
+        }
+        let ray = Ray::new(origin, dir);
+        let inv = dir.recip();
+        let mut hits: Vec<Hit> = self
+            .candidates_where(filter, predicate)
+            .filter(|(.., aabb, _)| ray_aabb(origin, inv, aabb, max_distance).is_some())
+            .filter_map(|(e, c, x, q, com, ..)| {
+                let i = c.shape().cast_ray_and_get_normal(
+                    &pose(x, q, com),
+                    &ray,
+                    max_distance,
+                    true,
+                )?;
+                Some(Hit {
+                    entity: e,
+                    distance: i.time_of_impact,
+                    point: origin + dir * i.time_of_impact,
+                    normal: i.normal,
+                })
+            })
+            .collect();
+        sort_and_cap(&mut hits, max_hits);
+        hits
+    }
+
+    /// The first collider `predicate` accepts along the ray ([`Self::cast_ray`] with a
+    /// predicate: skip one-way platforms, the player's own parts, ...).
+    #[must_use]
+    pub fn cast_ray_predicate(
+        &self,
+        origin: Vec3,
+        direction: Vec3,
+        max_distance: f32,
+        filter: &QueryFilter,
+        predicate: &dyn Fn(Entity) -> bool,
+    ) -> Option<Hit> {
+        self.ray_hits(origin, direction, max_distance, 1, filter, predicate)
+            .into_iter()
+            .next()
+    }
+
+    /// Every collider that `shape`, placed at (`position`, `rotation`) and swept along
+    /// `direction`, touches within `max_distance` (m) and `predicate` accepts, nearest first
+    /// (ties by entity), at most `max_hits`.
+    #[must_use]
+    #[allow(clippy::too_many_arguments)]
+    pub fn shape_hits(
+        &self,
+        shape: &Collider,
+        (position, rotation): (Vec3, Quat),
+        direction: Vec3,
+        max_distance: f32,
+        max_hits: usize,
+        filter: &QueryFilter,
+        predicate: &dyn Fn(Entity) -> bool,
+    ) -> Vec<Hit> {
+        let Some(dir) = direction.try_normalize() else {
+            return Vec::new();
+        };
+        let Some(rotation) = unit_rotation(rotation) else {
+            return Vec::new();
+        };
+        if !(position.is_finite() && max_distance >= 0.0 && max_distance.is_finite()) {
+            return Vec::new();
+        }
+        let start = Pose::from_parts(position, rotation);
+        let swept = shape.shape().compute_swept_aabb(
+            &start,
+            &Pose::from_parts(position + dir * max_distance, rotation),
+        );
+        let options = ShapeCastOptions::with_max_time_of_impact(max_distance);
+        let mut hits: Vec<Hit> = self
+            .candidates_where(filter, predicate)
+            .filter(|(.., aabb, _)| {
+                !(swept.maxs.cmplt(aabb.min).any() || swept.mins.cmpgt(aabb.max).any())
+            })
+            .filter_map(|(e, c, x, q, com, ..)| {
+                let target = pose(x, q, com);
+                let h = guarded(|| {
+                    parry3d::query::cast_shapes(
+                        &start,
+                        dir,
+                        &**shape.shape(),
+                        &target,
+                        Vec3::ZERO,
+                        &**c.shape(),
+                        options,
+                    )
+                })?
+                .ok()??;
+                Some(Hit {
+                    entity: e,
+                    distance: h.time_of_impact,
+                    point: target * h.witness2,
+                    normal: target.rotation * h.normal2,
+                })
+            })
+            .collect();
+        sort_and_cap(&mut hits, max_hits);
+        hits
+    }
+
+    /// Every collider containing `point` (on its surface counts), sorted.
+    #[must_use]
+    pub fn colliders_at_point(&self, point: Vec3, filter: &QueryFilter) -> Vec<Entity> {
+        if !point.is_finite() {
+            return Vec::new();
+        }
+        let mut out: Vec<Entity> = self
+            .candidates(filter)
+            .filter(|(.., aabb, _)| point.cmpge(aabb.min).all() && point.cmple(aabb.max).all())
+            .filter(|(_, c, x, q, com, ..)| {
+                parry3d::query::PointQuery::contains_point(&**c.shape(), &pose(x, q, *com), point)
+            })
+            .map(|c| c.0)
+            .collect();
+        out.sort_unstable();
+        out
     }
 
     /// The first collider a ray from `origin` along `direction` hits within `max_distance`
@@ -185,47 +335,17 @@ impl SpatialQuery<'_, '_> {
         max_distance: f32,
         filter: &QueryFilter,
     ) -> Option<Hit> {
-        let dir = direction.try_normalize()?;
-        let rotation = unit_rotation(rotation)?;
-        if !(position.is_finite() && max_distance >= 0.0 && max_distance.is_finite()) {
-            return None;
-        }
-        let start = Pose::from_parts(position, rotation);
-        let swept = shape.shape().compute_swept_aabb(
-            &start,
-            &Pose::from_parts(position + dir * max_distance, rotation),
-        );
-        let options = ShapeCastOptions::with_max_time_of_impact(max_distance);
-        let mut best = None;
-        for (e, c, x, q, com, _, aabb, _) in self.candidates(filter) {
-            if swept.maxs.cmplt(aabb.min).any() || swept.mins.cmpgt(aabb.max).any() {
-                continue;
-            }
-            let target = pose(x, q, com);
-            let hit = guarded(|| {
-                parry3d::query::cast_shapes(
-                    &start,
-                    dir,
-                    &**shape.shape(),
-                    &target,
-                    Vec3::ZERO,
-                    &**c.shape(),
-                    options,
-                )
-            });
-            if let Some(Ok(Some(h))) = hit {
-                nearer(
-                    &mut best,
-                    Hit {
-                        entity: e,
-                        distance: h.time_of_impact,
-                        point: target * h.witness2,
-                        normal: target.rotation * h.normal2,
-                    },
-                );
-            }
-        }
-        best
+        self.shape_hits(
+            shape,
+            (position, rotation),
+            direction,
+            max_distance,
+            1,
+            filter,
+            &|_| true,
+        )
+        .into_iter()
+        .next()
     }
 
     /// The collider nearest to `point` and its closest point, searching within
@@ -314,6 +434,16 @@ impl SpatialQuery<'_, '_> {
         out.sort_unstable();
         out
     }
+}
+
+/// Orders hits nearest first, ties by entity, and keeps the first `max_hits`.
+fn sort_and_cap(hits: &mut Vec<Hit>, max_hits: usize) {
+    hits.sort_unstable_by(|a, b| {
+        a.distance
+            .total_cmp(&b.distance)
+            .then(a.entity.cmp(&b.entity))
+    });
+    hits.truncate(max_hits);
 }
 
 /// `q` as a unit quaternion; none for a zero or non-finite one (whose "normalised" form is
