@@ -58,7 +58,7 @@ pub use diagnostics::PhysicsDiagnosticsPlugin;
 pub use interpolation::{
     PhysicsInterpolationPlugin, PoseHistory, TransformExtrapolation, TransformInterpolation,
 };
-pub use transform::PhysicsTransformPlugin;
+pub use transform::{PhysicsTransformPlugin, TransformScaleIgnored};
 
 use bevy_app::{App, FixedPostUpdate, Plugin, PluginGroup, PluginGroupBuilder};
 use bevy_ecs::intern::Interned;
@@ -147,6 +147,7 @@ fn register_messages(world: &mut World) {
     MessageRegistry::register_message::<crate::integrator::StabilityWarning>(world);
     MessageRegistry::register_message::<crate::core::restore::ResourceRestored>(world);
     MessageRegistry::register_message::<crate::core::restore::InvalidSetting>(world);
+    MessageRegistry::register_message::<TransformScaleIgnored>(world);
     world.insert_resource(MessagesRegistered);
 }
 

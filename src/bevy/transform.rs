@@ -16,7 +16,8 @@
 //!
 //! On first sight a body's `Transform` wins, unless it is the identity while the physics
 //! pose is not (a body spawned with `Position`): then the physics pose wins. Scale is left
-//! alone and does not scale colliders.
+//! alone and does not scale colliders: a body or collider whose `Transform` has a scale
+//! other than one is reported once with a [`TransformScaleIgnored`] message.
 
 use bevy_app::{App, Plugin};
 use bevy_ecs::hierarchy::ChildOf;
@@ -45,7 +46,8 @@ impl Plugin for PhysicsTransformPlugin {
         app.add_systems(
             schedule,
             (
-                (read_transforms, read_child_offsets).in_set(PhysicsAppSystems::ReadTransforms),
+                (read_transforms, read_child_offsets, report_scales)
+                    .in_set(PhysicsAppSystems::ReadTransforms),
                 (write_transforms, release_transform_targets).in_set(PhysicsAppSystems::Writeback),
             ),
         );
@@ -277,5 +279,43 @@ fn release_transform_targets(
         commands
             .entity(e)
             .remove::<(KinematicTarget, TargetFromTransform)>();
+    }
+}
+
+/// A body or collider's `Transform` has a scale other than one, which hooke does not apply
+/// to its collider or mass: scale the shape itself (`Collider::cuboid` with the scaled half
+/// extents, say). Written once per entity, the first time hooke sees the scale.
+#[derive(bevy_ecs::message::Message, Debug, Clone, Copy, PartialEq)]
+pub struct TransformScaleIgnored {
+    /// The entity.
+    pub entity: Entity,
+    /// Its `Transform` scale.
+    pub scale: Vec3,
+}
+
+/// Marks an entity whose ignored scale was reported.
+#[derive(Component, Debug, Clone, Copy)]
+pub(crate) struct ScaleReported;
+
+type Scaled = (
+    Or<(With<RigidBody>, With<Collider>)>,
+    Without<ScaleReported>,
+    Changed<Transform>,
+);
+
+/// Reports once each body or collider whose `Transform` scale is not one.
+fn report_scales(
+    mut commands: Commands,
+    entities: Query<(Entity, &Transform), Scaled>,
+    mut messages: bevy_ecs::message::MessageWriter<TransformScaleIgnored>,
+) {
+    for (e, t) in &entities {
+        if t.scale != Vec3::ONE {
+            messages.write(TransformScaleIgnored {
+                entity: e,
+                scale: t.scale,
+            });
+            commands.entity(e).insert(ScaleReported);
+        }
     }
 }

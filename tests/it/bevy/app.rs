@@ -515,3 +515,39 @@ fn a_door_hinged_in_an_app_swings_about_its_hinge() {
     assert!(angle > 0.5, "turned {angle} rad");
     assert!(axis.y.abs() > 0.999, "about {axis}");
 }
+
+#[derive(Resource, Default)]
+struct ScalesSeen(Vec<(Entity, Vec3)>);
+
+#[test]
+fn a_scaled_transform_is_reported_once_not_silently_ignored() {
+    let mut app = app(60.0);
+    app.init_resource::<ScalesSeen>();
+    app.add_systems(
+        Update,
+        |mut reader: MessageReader<hooke::bevy::TransformScaleIgnored>,
+         mut seen: ResMut<ScalesSeen>| {
+            seen.0.extend(reader.read().map(|m| (m.entity, m.scale)));
+        },
+    );
+    let scaled = spawn(
+        &mut app,
+        (
+            RigidBody::Dynamic,
+            Collider::ball(0.5).unwrap(),
+            Transform::from_xyz(0.0, 5.0, 0.0).with_scale(Vec3::splat(2.0)),
+        ),
+    );
+    let plain = spawn(
+        &mut app,
+        (
+            RigidBody::Dynamic,
+            Collider::ball(0.5).unwrap(),
+            Transform::from_xyz(3.0, 5.0, 0.0),
+        ),
+    );
+    frames(&mut app, 30);
+    let seen = &app.world().resource::<ScalesSeen>().0;
+    assert_eq!(seen, &vec![(scaled, Vec3::splat(2.0))]);
+    assert!(!seen.iter().any(|(e, _)| *e == plain));
+}

@@ -35,6 +35,7 @@ const INTERNAL: &[&str] = &[
     "hooke::collision::attach::OwnShape",
     "hooke::joints::plugin::Scratch",
     "hooke::bevy::transform::TargetFromTransform",
+    "hooke::bevy::transform::ScaleReported",
     "hooke::rigid::mass::ComputedMass",
 ];
 
