@@ -18,7 +18,7 @@
 //! ```
 //!
 //! Everything is drawn at its physics pose ([`Position`], [`Rotation`]) in `PostUpdate`,
-//! once per frame: an interpolated `Transform` may be up to a step ahead of it.
+//! once per frame: a mesh whose `Transform` is interpolated lags that pose by up to a step.
 
 use bevy_app::{App, Plugin, PostUpdate};
 use bevy_color::Color;
