@@ -401,7 +401,7 @@ fn draw_meshes(
         let tets = body.tets();
         let entry = surfaces.entry(e).or_default();
         if entry.0 != tets.len() || entry.1.is_empty() {
-            *entry = (tets.len(), crate::soft::surface_edges(tets));
+            *entry = (tets.len(), surface_edges(tets));
         }
         let p = nodes.positions();
         for &edge in &entry.1 {
@@ -427,4 +427,17 @@ fn draw_velocities(
             gizmos.arrow(x.get(), x.get() + scale * v, colour);
         }
     }
+}
+
+/// The edges of the boundary of `tets` (its surface triangles), each once, sorted.
+#[must_use]
+fn surface_edges(tets: &[[u32; 4]]) -> Vec<[u32; 2]> {
+    let mut edges: Vec<[u32; 2]> = crate::soft::mesh::surface_of(tets)
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
 }

@@ -281,17 +281,3 @@ pub(crate) fn surface_of(tets: &[[u32; 4]]) -> Vec<[u32; 3]> {
     }
     out
 }
-
-/// The edges of the boundary of `tets` ([`surface_of`]), each once, sorted.
-#[cfg(feature = "debug-plugin")]
-#[must_use]
-pub(crate) fn surface_edges(tets: &[[u32; 4]]) -> Vec<[u32; 2]> {
-    let mut edges: Vec<[u32; 2]> = surface_of(tets)
-        .iter()
-        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
-        .map(|[a, b]| [a.min(b), a.max(b)])
-        .collect();
-    edges.sort_unstable();
-    edges.dedup();
-    edges
-}

@@ -43,8 +43,6 @@ mod targets;
 
 pub use crate::integrator::ImplicitReport;
 pub use attach::{MAX_ATTACHED_NODES, NodeAttachments};
-#[cfg(feature = "debug-plugin")]
-pub(crate) use mesh::surface_edges;
 pub use mesh::{CellSplit, TetMesh};
 pub use plugin::SoftBodyPlugin;
 pub use stability::SoftStability;
