@@ -41,6 +41,7 @@
 //! | [`SleepPlugin`](crate::sleep::SleepPlugin) | resting islands stop costing anything | [`Collider`](crate::collision::Collider) bodies |
 //! | [`soft::SoftBodyPlugin`] | tetrahedral FEM: elastic forces of the four strain models | [`soft::SoftBody`] |
 //! | [`cloth::ClothPlugin`] | wind on triangles, strain limiting, node collisions, vertex normals | [`cloth::Cloth`] |
+//! | [`character::CharacterControllerPlugin`] | move-and-slide, slopes, steps, ground snapping, platforms, pushing | [`character::CharacterController`] |
 //!
 //! With the `bevy` feature, [`PhysicsPlugins`] is also a Bevy `PluginGroup`, every plugin above
 //! a Bevy `Plugin`, and the `bevy` module adds the App clock, `Transform` sync, interpolation and
@@ -147,6 +148,7 @@
 
 #[cfg(feature = "bevy")]
 pub mod bevy;
+pub mod character;
 pub mod cloth;
 pub mod collision;
 pub mod core;
@@ -178,6 +180,9 @@ pub mod prelude {
         PhysicsAppSystems, PhysicsDiagnosticsPlugin, PhysicsSchedulePlugin, TransformExtrapolation,
         TransformInterpolation,
     };
+    pub use crate::character::CharacterController;
+    pub use crate::character::CharacterInput;
+    pub use crate::character::CharacterState;
     pub use crate::cloth::ClothBuilder;
     pub use crate::collision::Collider;
     pub use crate::collision::ColliderDensity;
@@ -191,6 +196,8 @@ pub mod prelude {
     pub use crate::collision::ContactStarted;
     pub use crate::collision::Contacts;
     pub use crate::collision::Friction;
+    pub use crate::collision::LayerMask;
+    pub use crate::collision::PhysicsLayer;
     pub use crate::collision::Restitution;
     pub use crate::collision::Sensor;
     pub use crate::collision::SpatialQuery;
@@ -232,9 +239,12 @@ pub mod prelude {
     pub use crate::particles::Tracer;
     pub use crate::particles::VelocityField;
     pub use crate::rigid::AngularVelocity;
+    pub use crate::rigid::BodyForces;
     pub use crate::rigid::CenterOfMass;
     pub use crate::rigid::Inertia;
     pub use crate::rigid::MassProperties;
+    pub use crate::rigid::MaxAngularSpeed;
+    pub use crate::rigid::MaxLinearSpeed;
     pub use crate::rigid::RigidBody;
     pub use crate::rigid::RigidBodyBundle;
     pub use crate::rigid::Rotation;

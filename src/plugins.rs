@@ -2,6 +2,7 @@
 
 use bevy_ecs::prelude::*;
 
+use crate::character::CharacterControllerPlugin;
 use crate::cloth::ClothPlugin;
 use crate::collision::CollisionPlugin;
 use crate::core::error::Result;
@@ -16,7 +17,7 @@ use crate::soft::SoftBodyPlugin;
 use crate::springs::SpringPlugin;
 
 /// Every effect: gravity, damping, velocity fields, springs, rigid bodies, collisions,
-/// sleeping, soft bodies and cloth, on the kernel and the integrators.
+/// sleeping, soft bodies, cloth and character controllers, on the kernel and the integrators.
 #[derive(Debug, Default, Clone, Copy)]
 pub struct PhysicsPlugins;
 
@@ -32,7 +33,8 @@ impl WorldPlugin for PhysicsPlugins {
             .add_physics(JointPlugin)
             .add_physics(SleepPlugin)
             .add_physics(SoftBodyPlugin)
-            .add_physics(ClothPlugin);
+            .add_physics(ClothPlugin)
+            .add_physics(CharacterControllerPlugin);
     }
 }
 

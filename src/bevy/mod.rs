@@ -69,6 +69,7 @@ use bevy_time::{Fixed, Time};
 use bevy_transform::components::Transform;
 use glam::{Quat, Vec3};
 
+use crate::character::CharacterControllerPlugin;
 use crate::cloth::ClothPlugin;
 use crate::collision::CollisionPlugin;
 use crate::collision::ContactEnded;
@@ -217,7 +218,8 @@ bevy_plugin!(
     JointPlugin,
     SleepPlugin,
     SoftBodyPlugin,
-    ClothPlugin
+    ClothPlugin,
+    CharacterControllerPlugin
 );
 
 /// `app.add_plugins(PhysicsPlugins)`: the clock ([`PhysicsSchedulePlugin`]), every effect,
@@ -238,6 +240,7 @@ impl PluginGroup for PhysicsPlugins {
             .add(SleepPlugin)
             .add(SoftBodyPlugin)
             .add(ClothPlugin)
+            .add(CharacterControllerPlugin)
             .add(PhysicsTransformPlugin)
             .add(PhysicsInterpolationPlugin)
     }

@@ -34,6 +34,10 @@ pub(super) fn register_types(app: &mut App) {
         crate::core::time::SubstepTime,
         crate::core::whole_step::WholeStep,
         crate::sleep::SleepSettings,
+        // Character controllers.
+        crate::character::CharacterController,
+        crate::character::CharacterInput,
+        crate::character::CharacterState,
         // Particles and fields.
         crate::particles::Position,
         crate::particles::LinearVelocity,
@@ -68,6 +72,8 @@ pub(super) fn register_types(app: &mut App) {
         crate::rigid::ExternalTorque,
         crate::rigid::Inertia,
         crate::rigid::KinematicTarget,
+        crate::rigid::MaxLinearSpeed,
+        crate::rigid::MaxAngularSpeed,
         crate::rigid::OrientationUpdate,
         crate::rigid::Renormalization,
         crate::rigid::RigidBody,

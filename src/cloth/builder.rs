@@ -23,6 +23,7 @@ pub struct ClothBuilder {
     k_bend: f32,
     damping: [f32; 3],
     pin_corners: bool,
+    thickness: Option<f32>,
 }
 
 impl ClothBuilder {
@@ -44,6 +45,7 @@ impl ClothBuilder {
             k_bend: 1.0,
             damping: [0.01; 3],
             pin_corners: true,
+            thickness: None,
         }
     }
 
@@ -51,6 +53,14 @@ impl ClothBuilder {
     #[must_use]
     pub fn stiffness(mut self, structural: f32, shear: f32, bend: f32) -> Self {
         (self.k_structural, self.k_shear, self.k_bend) = (structural, shear, bend);
+        self
+    }
+
+    /// How far the nodes keep from colliders (m; the cloth collides with every collider at
+    /// [`Cloth`]'s default 0.01 m without it).
+    #[must_use]
+    pub fn thickness(mut self, metres: f32) -> Self {
+        self.thickness = Some(metres);
         self
     }
 
@@ -170,7 +180,10 @@ impl ClothBuilder {
                 d == 1 && a / nx == b / nx || d == e
             })
             .collect();
-        let cloth = Cloth::new(triangles, structural, nodes.len());
+        let mut cloth = Cloth::new(triangles, structural, nodes.len());
+        if let Some(t) = self.thickness {
+            cloth = cloth.with_thickness(t)?;
+        }
         Ok((nodes, net, cloth))
     }
 

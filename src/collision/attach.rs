@@ -500,7 +500,7 @@ fn set_mass(world: &mut World, body: Entity, parts: &[Part]) {
         (Some(_), None) => true,
         _ => false,
     };
-    if user_mass || parts.is_empty() {
+    if parts.is_empty() {
         return;
     }
     let total = parts
@@ -511,7 +511,28 @@ fn set_mass(world: &mut World, body: Entity, parts: &[Part]) {
         .as_ref()
         .and_then(|t| mass_from_parry(t).ok())
         .unwrap_or_else(crate::rigid::default_mass);
-    crate::rigid::insert_computed_mass(world, body, props);
+    if !user_mass {
+        crate::rigid::insert_computed_mass(world, body, props);
+        return;
+    }
+    // The user's mass with the colliders' shape: their inertia scaled to that mass and their
+    // centre of mass (as rapier and avian do), unless the user gave an inertia too. Without
+    // it the body had no inertia at all and never turned.
+    let Some(m) = world.get::<Mass>(body).map(Mass::value) else {
+        return;
+    };
+    if world.get::<Inertia>(body).is_some() || !(m.is_finite() && m > 0.0) {
+        return;
+    }
+    let inertia = props.inertia;
+    let Ok(scaled) = Inertia::new(inertia.principal() * (m / props.mass), inertia.frame()) else {
+        return;
+    };
+    if let Ok(scaled_props) = crate::rigid::MassProperties::new(m, props.center_of_mass, scaled) {
+        crate::rigid::insert_computed_mass(world, body, scaled_props);
+        // The mass is still the user's: a later collider change must not replace it.
+        world.entity_mut(body).remove::<ComputedMass>();
+    }
 }
 
 fn mass_from_parry(p: &ParryMass) -> Result<crate::rigid::MassProperties> {

@@ -62,6 +62,7 @@ pub(crate) mod broad_phase;
 mod casters;
 pub mod coincident;
 pub(crate) mod lanes;
+mod layers;
 pub(crate) mod narrow_phase;
 pub(crate) mod nodes;
 mod plugin;
@@ -74,6 +75,7 @@ pub(crate) mod support;
 
 pub(crate) use attach::OwnShape;
 pub use attach::{ColliderDensity, ColliderOf, ColliderOffset, MAX_PART_DEPTH};
+pub use layers::{CollisionLayers, LayerMask, PhysicsLayer};
 pub(crate) use narrow_phase::ContactsRecord;
 pub use narrow_phase::{ContactPair, Contacts};
 pub(crate) use nodes::coupling::NodeImpulse;
@@ -175,7 +177,7 @@ pub(crate) fn restore_broad_phase(
     }
 }
 pub use casters::{RayCaster, RayHits, ShapeCaster, ShapeHits};
-pub use query::{Hit, Projection, QueryFilter, SpatialQuery};
+pub use query::{Hit, Projection, QueryFilter, ShapeContact, SpatialQuery};
 
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3, Vec3A};
@@ -697,34 +699,6 @@ impl CombineRule {
             CombineRule::Max => a.max(b),
             CombineRule::Multiply => a * b,
         }
-    }
-}
-
-/// Which colliders may touch: a pair interacts when each one's `memberships` meets the
-/// other's `filters`. Default: every layer, colliding with every layer.
-#[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq, Eq)]
-#[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
-pub struct CollisionLayers {
-    /// Layers this collider is on (bit mask).
-    pub memberships: u32,
-    /// Layers this collider collides with (bit mask).
-    pub filters: u32,
-}
-
-impl Default for CollisionLayers {
-    fn default() -> Self {
-        Self {
-            memberships: u32::MAX,
-            filters: u32::MAX,
-        }
-    }
-}
-
-impl CollisionLayers {
-    /// True when the two colliders may interact.
-    #[must_use]
-    pub fn interacts(self, other: Self) -> bool {
-        self.memberships & other.filters != 0 && other.memberships & self.filters != 0
     }
 }
 

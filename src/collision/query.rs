@@ -39,6 +39,14 @@ impl Default for QueryFilter {
 }
 
 impl QueryFilter {
+    /// Only colliders on `layers` (a [`super::LayerMask`], a `u32`, or
+    /// `LayerMask::from_layers([MyLayer::Enemy])?`).
+    #[must_use]
+    pub fn with_mask(mut self, layers: impl Into<super::LayerMask>) -> Self {
+        self.mask = layers.into().0;
+        self
+    }
+
     /// The default filter, also skipping `entity`.
     #[must_use]
     pub fn excluding(entity: Entity) -> Self {
@@ -61,6 +69,19 @@ pub struct Hit {
     pub point: Vec3,
     /// World surface normal of the hit collider at the point.
     pub normal: Vec3,
+}
+
+/// A collider near a shape ([`SpatialQuery::shape_contacts`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShapeContact {
+    /// The collider.
+    pub entity: Entity,
+    /// The collider's point nearest the shape (m, world).
+    pub point: Vec3,
+    /// World normal out of the collider, towards the shape.
+    pub normal: Vec3,
+    /// Signed distance between the two (m; negative when they overlap).
+    pub distance: f32,
 }
 
 /// The closest collider point to a query point.
@@ -121,11 +142,42 @@ fn nearer(best: &mut Option<Hit>, hit: Hit) {
     }
 }
 
+/// A candidate collider: entity, shape, pose parts, layers, bounding box, sensor flag.
+type Candidate<'a> = (
+    Entity,
+    &'a Collider,
+    &'a Position,
+    &'a Rotation,
+    Option<&'a CenterOfMass>,
+    &'a CollisionLayers,
+    ColliderAabb,
+    bool,
+);
+
+/// The collider's box as of the last step, or, for one spawned since (whose box is still
+/// the default empty one at the origin), its box now.
+fn bounds(
+    aabb: &ColliderAabb,
+    c: &Collider,
+    x: &Position,
+    q: &Rotation,
+    com: Option<&CenterOfMass>,
+) -> ColliderAabb {
+    if aabb.min != aabb.max {
+        return *aabb;
+    }
+    let b = c.shape().compute_aabb(&pose(x, q, com));
+    ColliderAabb {
+        min: b.mins,
+        max: b.maxs,
+    }
+}
+
 impl SpatialQuery<'_, '_> {
     fn candidates<'a>(
         &'a self,
         filter: &'a QueryFilter,
-    ) -> impl Iterator<Item = bevy_ecs::query::QueryItem<'a, 'a, QueryCollider<'static>>> + 'a {
+    ) -> impl Iterator<Item = Candidate<'a>> + 'a {
         self.candidates_where(filter, &|_| true)
     }
 
@@ -134,13 +186,18 @@ impl SpatialQuery<'_, '_> {
         &'a self,
         filter: &'a QueryFilter,
         predicate: &'a dyn Fn(Entity) -> bool,
-    ) -> impl Iterator<Item = bevy_ecs::query::QueryItem<'a, 'a, QueryCollider<'static>>> + 'a {
-        self.colliders.iter().filter(move |c| {
-            c.5.memberships & filter.mask != 0
-                && (filter.include_sensors || !c.7)
-                && !filter.exclude.contains(&c.0)
-                && predicate(c.0)
-        })
+    ) -> impl Iterator<Item = Candidate<'a>> + 'a {
+        self.colliders
+            .iter()
+            .filter(move |c| {
+                c.5.memberships & filter.mask != 0
+                    && (filter.include_sensors || !c.7)
+                    && !filter.exclude.contains(&c.0)
+                    && predicate(c.0)
+            })
+            .map(|(e, c, x, q, com, layers, aabb, sensor)| {
+                (e, c, x, q, com, layers, bounds(aabb, c, x, q, com), sensor)
+            })
     }
 
     /// Every collider a ray from `origin` along `direction` hits within `max_distance` (m)
@@ -217,6 +274,71 @@ impl SpatialQuery<'_, '_> {
         filter: &QueryFilter,
         predicate: &dyn Fn(Entity) -> bool,
     ) -> Vec<Hit> {
+        let options = ShapeCastOptions::with_max_time_of_impact(max_distance);
+        self.sweep(
+            shape,
+            (position, rotation),
+            direction,
+            options,
+            max_hits,
+            filter,
+            predicate,
+        )
+    }
+
+    /// The first collider that `shape`, moved from (`position`, `rotation`) along
+    /// `direction`, would come within `gap` (m) of within `max_distance` (m): the distance of
+    /// the hit is how far the shape can move and stay `gap` away. Colliders it already
+    /// overlaps or is nearer than `gap` to count only if the move closes in on them, so a
+    /// shape resting on the ground can slide along it or lift off (what a character
+    /// controller needs; see [`crate::character`]).
+    #[must_use]
+    #[allow(clippy::too_many_arguments)]
+    pub fn cast_shape_with_gap(
+        &self,
+        shape: &Collider,
+        (position, rotation): (Vec3, Quat),
+        direction: Vec3,
+        max_distance: f32,
+        gap: f32,
+        filter: &QueryFilter,
+        predicate: &dyn Fn(Entity) -> bool,
+    ) -> Option<Hit> {
+        if !(gap >= 0.0 && gap.is_finite()) {
+            return None;
+        }
+        let options = ShapeCastOptions {
+            max_time_of_impact: max_distance,
+            target_distance: gap,
+            stop_at_penetration: false,
+            compute_impact_geometry_on_penetration: true,
+        };
+        self.sweep(
+            shape,
+            (position, rotation),
+            direction,
+            options,
+            1,
+            filter,
+            predicate,
+        )
+        .into_iter()
+        .next()
+    }
+
+    /// The shared body of the shape casts.
+    #[allow(clippy::too_many_arguments)]
+    fn sweep(
+        &self,
+        shape: &Collider,
+        (position, rotation): (Vec3, Quat),
+        direction: Vec3,
+        options: ShapeCastOptions,
+        max_hits: usize,
+        filter: &QueryFilter,
+        predicate: &dyn Fn(Entity) -> bool,
+    ) -> Vec<Hit> {
+        let max_distance = options.max_time_of_impact;
         let Some(dir) = direction.try_normalize() else {
             return Vec::new();
         };
@@ -227,16 +349,15 @@ impl SpatialQuery<'_, '_> {
             return Vec::new();
         }
         let start = Pose::from_parts(position, rotation);
-        let swept = shape.shape().compute_swept_aabb(
+        let mut swept = shape.shape().compute_swept_aabb(
             &start,
             &Pose::from_parts(position + dir * max_distance, rotation),
         );
-        let options = ShapeCastOptions::with_max_time_of_impact(max_distance);
+        swept.mins -= Vec3::splat(options.target_distance);
+        swept.maxs += Vec3::splat(options.target_distance);
         let mut hits: Vec<Hit> = self
             .candidates_where(filter, predicate)
-            .filter(|(.., aabb, _)| {
-                !(swept.maxs.cmplt(aabb.min).any() || swept.mins.cmpgt(aabb.max).any())
-            })
+            .filter(|(.., aabb, _)| !misses(&swept, aabb))
             .filter_map(|(e, c, x, q, com, ..)| {
                 let target = pose(x, q, com);
                 let h = guarded(|| {
@@ -261,6 +382,47 @@ impl SpatialQuery<'_, '_> {
             .collect();
         sort_and_cap(&mut hits, max_hits);
         hits
+    }
+
+    /// Every collider within `prediction` (m) of `shape` at (`position`, `rotation`), with
+    /// the signed distance and the normal pointing out of the collider towards the shape,
+    /// sorted by entity. A negative distance is a penetration depth.
+    #[must_use]
+    pub fn shape_contacts(
+        &self,
+        shape: &Collider,
+        (position, rotation): (Vec3, Quat),
+        prediction: f32,
+        filter: &QueryFilter,
+    ) -> Vec<ShapeContact> {
+        let Some((at, bounds)) = placed(shape, position, rotation, prediction) else {
+            return Vec::new();
+        };
+        let mut out: Vec<ShapeContact> = self
+            .candidates(filter)
+            .filter(|(.., aabb, _)| !misses(&bounds, aabb))
+            .filter_map(|(e, c, x, q, com, ..)| {
+                let target = pose(x, q, com);
+                let contact = guarded(|| {
+                    parry3d::query::contact(
+                        &at,
+                        &**shape.shape(),
+                        &target,
+                        &**c.shape(),
+                        prediction,
+                    )
+                })?
+                .ok()??;
+                Some(ShapeContact {
+                    entity: e,
+                    point: contact.point2,
+                    normal: contact.normal2,
+                    distance: contact.dist,
+                })
+            })
+            .collect();
+        out.sort_unstable_by_key(|c| c.entity);
+        out
     }
 
     /// Every collider containing `point` (on its surface counts), sorted.
@@ -299,7 +461,7 @@ impl SpatialQuery<'_, '_> {
         let inv = dir.recip();
         let mut best = None;
         for (e, c, x, q, com, _, aabb, _) in self.candidates(filter) {
-            let Some(enter) = ray_aabb(origin, inv, aabb, max_distance) else {
+            let Some(enter) = ray_aabb(origin, inv, &aabb, max_distance) else {
                 continue;
             };
             if best.is_some_and(|b: Hit| enter > b.distance) {
@@ -405,19 +567,12 @@ impl SpatialQuery<'_, '_> {
         rotation: Quat,
         filter: &QueryFilter,
     ) -> Vec<Entity> {
-        let Some(rotation) = unit_rotation(rotation) else {
+        let Some((at, bounds)) = placed(shape, position, rotation, 0.0) else {
             return Vec::new();
         };
-        if !position.is_finite() {
-            return Vec::new();
-        }
-        let at = Pose::from_parts(position, rotation);
-        let bounds = shape.shape().compute_aabb(&at);
         let mut out: Vec<Entity> = self
             .candidates(filter)
-            .filter(|(_, _, _, _, _, _, aabb, _)| {
-                !(bounds.maxs.cmplt(aabb.min).any() || bounds.mins.cmpgt(aabb.max).any())
-            })
+            .filter(|(.., aabb, _)| !misses(&bounds, aabb))
             .filter(|(_, c, x, q, com, ..)| {
                 guarded(|| {
                     parry3d::query::intersection_test(
@@ -434,6 +589,30 @@ impl SpatialQuery<'_, '_> {
         out.sort_unstable();
         out
     }
+}
+
+/// `shape` placed at (`position`, `rotation`) and its bounding box grown by `grow` (m);
+/// none for a non-finite position or grow, or a bad rotation.
+fn placed(
+    shape: &Collider,
+    position: Vec3,
+    rotation: Quat,
+    grow: f32,
+) -> Option<(Pose, parry3d::bounding_volume::Aabb)> {
+    let rotation = unit_rotation(rotation)?;
+    if !(position.is_finite() && grow >= 0.0 && grow.is_finite()) {
+        return None;
+    }
+    let at = Pose::from_parts(position, rotation);
+    let mut bounds = shape.shape().compute_aabb(&at);
+    bounds.mins -= Vec3::splat(grow);
+    bounds.maxs += Vec3::splat(grow);
+    Some((at, bounds))
+}
+
+/// Whether a query's box and a collider's box are apart.
+fn misses(bounds: &parry3d::bounding_volume::Aabb, aabb: &ColliderAabb) -> bool {
+    bounds.maxs.cmplt(aabb.min).any() || bounds.mins.cmpgt(aabb.max).any()
 }
 
 /// Orders hits nearest first, ties by entity, and keeps the first `max_hits`.

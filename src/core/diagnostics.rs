@@ -71,7 +71,7 @@ pub struct PhysicsDiagnostics {
     pub counts: BodyCounts,
     /// Wall time per [`StepSystems`] set, in `StepSystems::ORDER`, summed over substeps.
     /// Zero after a step on the whole-step path, which has no sets.
-    pub set_times: [Duration; 9],
+    pub set_times: [Duration; 10],
     /// Whether the last step ran its substeps on the whole-step path (see
     /// [`crate::core::whole_step`]) instead of through [`crate::core::schedule::SubstepSchedule`].
     pub whole_step: bool,
@@ -144,7 +144,7 @@ impl Default for DiagnosticsSettings {
 #[derive(Resource, Default)]
 struct SetClock {
     last: Option<Instant>,
-    acc: [Duration; 9],
+    acc: [Duration; 10],
 }
 
 pub(crate) fn install(world: &mut World) {
@@ -152,7 +152,7 @@ pub(crate) fn install(world: &mut World) {
     world.add_observer(count_quarantine);
     crate::core::restore::init::<DiagnosticsSettings>(world);
     crate::core::restore::init::<SetClock>(world);
-    for k in 0..=9u8 {
+    for k in 0..=10u8 {
         add_own_systems(
             world,
             SubstepSchedule,

@@ -20,6 +20,7 @@
 //!     RelaxSystems::Cloth             cloth strain limiting, then node contacts
 //!   StepSystems::CompleteStages     extra force evaluations of Verlet and RK4
 //!   StepSystems::Renormalize        unit quaternions
+//!   StepSystems::LimitSpeeds        speed caps
 //!
 //! ForceSchedule              the three force sets alone, re-run at stage states
 //! ```
@@ -83,11 +84,13 @@ pub enum StepSystems {
     CompleteStages,
     /// Orientations are renormalised to unit quaternions.
     Renormalize,
+    /// Speeds are capped ([`crate::rigid::MaxLinearSpeed`], [`crate::rigid::MaxAngularSpeed`]).
+    LimitSpeeds,
 }
 
 impl StepSystems {
     /// Every set in run order.
-    pub const ORDER: [StepSystems; 9] = [
+    pub const ORDER: [StepSystems; 10] = [
         StepSystems::ClearForces,
         StepSystems::ApplyForces,
         StepSystems::AccumulateTorque,
@@ -97,6 +100,7 @@ impl StepSystems {
         StepSystems::RelaxConstraints,
         StepSystems::CompleteStages,
         StepSystems::Renormalize,
+        StepSystems::LimitSpeeds,
     ];
 }
 
@@ -167,6 +171,9 @@ pub enum RelaxSystems {
 pub enum PrepareSystems {
     /// Inputs and bookkeeping.
     Inputs,
+    /// Character controllers move and slide against the world as the inputs left it (kinematic
+    /// platforms already driven), and push what they walk into.
+    Characters,
     /// Velocities game code wrote past the [`crate::core::quarantine::DivergenceGuard`] are quarantined before
     /// the contacts use them.
     Guard,
@@ -248,6 +255,7 @@ pub(crate) fn init_schedules(world: &mut World) {
     physics.configure_sets(
         (
             PrepareSystems::Inputs,
+            PrepareSystems::Characters,
             PrepareSystems::Guard,
             PrepareSystems::Sleep,
             PrepareSystems::Collision,
@@ -296,6 +304,7 @@ pub(crate) fn init_schedules(world: &mut World) {
         )
             .chain(),
     );
+    substep.configure_sets((ProbeSystems(9), StepSystems::LimitSpeeds, ProbeSystems(10)).chain());
 
     substep.configure_sets(
         (IntegrationSystems::Impulses, IntegrationSystems::Integrate)

@@ -82,12 +82,16 @@ finite_vec_component!(
 );
 finite_vec_component!(
     /// A force (N) added to the body after every force clear, until changed or removed.
-    /// Writing it from gameplay code is safe: the step never wipes it.
+    /// Writing it from gameplay code is safe: the step never wipes it. Bodies do not carry
+    /// one until given it, so `Query<&mut ExternalForce>` skips them:
+    /// `commands.entity(body).set_force(f)` ([`crate::rigid::BodyForces`]) inserts it.
     ExternalForce(Vec3),
     "external force"
 );
 finite_vec_component!(
     /// A one-shot impulse (N·s): at the next substep Δv = J / m, then it is reset to zero.
+    /// `commands.entity(body).apply_impulse(j)` ([`crate::rigid::BodyForces`]) adds one to a
+    /// body that has none yet.
     ExternalImpulse(Vec3),
     "impulse"
 );

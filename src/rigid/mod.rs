@@ -39,9 +39,13 @@
 //! [`KinematicTarget`]. [`RigidBody::Static`] bodies have no mass components at all, so no
 //! physics system ever visits them.
 
+mod forces;
+mod limits;
 mod mass;
 mod plugin;
 
+pub use forces::BodyForces;
+pub use limits::{MaxAngularSpeed, MaxLinearSpeed, speed_scale};
 pub(crate) use mass::{ComputedMass, insert_computed_mass};
 pub use mass::{MassProperties, RigidBodyBundle, default_mass, parallel_axis};
 pub use plugin::RigidBodyPlugin;
@@ -59,8 +63,9 @@ use crate::particles::Position;
 /// Spawn a body the way Bevy spawns anything, with required components:
 /// `(RigidBody::Dynamic, Collider::cuboid(0.5, 0.5, 0.5)?, Position(..))` is a dynamic body
 /// whose mass, centre of mass and inertia come from its colliders and their
-/// [`crate::collision::ColliderDensity`] (1000 kg/m³ by default), unless you give a [`crate::particles::Mass`] (or
-/// use [`RigidBodyBundle`]). Inserting another kind later changes the body: kinematic
+/// [`crate::collision::ColliderDensity`] (1000 kg/m³ by default). A [`crate::particles::Mass`] you give replaces
+/// the mass, and the colliders' inertia is scaled to it (give an [`Inertia`] too, or use
+/// [`RigidBodyBundle`], to set both). Inserting another kind later changes the body: kinematic
 /// bodies get infinite mass and inertia, static bodies lose their mass and velocity
 /// components.
 #[derive(
@@ -167,7 +172,8 @@ angular_vec!(
     "angular momentum"
 );
 angular_vec!(
-    /// A torque (N·m, world frame) added after every clear, until changed or removed.
+    /// A torque (N·m, world frame) added after every clear, until changed or removed
+    /// (`commands.entity(body).set_torque(t)`, [`BodyForces`], inserts it).
     ExternalTorque,
     "external torque"
 );

@@ -33,10 +33,14 @@ impl WorldPlugin for RigidBodyPlugin {
         crate::core::restore::init::<OrientationUpdate>(world);
         crate::core::quarantine::validate_writes::<super::AngularDamping>(world);
         crate::core::quarantine::validate_writes::<super::KinematicTarget>(world);
+        crate::core::quarantine::validate_writes::<super::MaxLinearSpeed>(world);
+        crate::core::quarantine::validate_writes::<super::MaxAngularSpeed>(world);
         crate::core::restore::init::<Renormalization>(world);
         crate::core::whole_step::block_on::<AngularDamping>(world);
         crate::core::whole_step::block_on::<ExternalForceAtPoint>(world);
         crate::core::whole_step::block_on::<SkipRenormalization>(world);
+        crate::core::whole_step::block_on::<super::MaxLinearSpeed>(world);
+        crate::core::whole_step::block_on::<super::MaxAngularSpeed>(world);
         add_own_systems(
             world,
             PhysicsSchedule,
@@ -60,9 +64,17 @@ impl WorldPlugin for RigidBodyPlugin {
         add_own_systems(
             world,
             SubstepSchedule,
-            (renormalize_rotations
-                .run_if(any_with_component::<Inertia>)
-                .in_set(StepSystems::Renormalize),),
+            (
+                renormalize_rotations
+                    .run_if(any_with_component::<Inertia>)
+                    .in_set(StepSystems::Renormalize),
+                super::limits::limit_speeds
+                    .run_if(
+                        any_with_component::<super::MaxLinearSpeed>
+                            .or_else(any_with_component::<super::MaxAngularSpeed>),
+                    )
+                    .in_set(StepSystems::LimitSpeeds),
+            ),
         );
     }
 }

@@ -26,6 +26,7 @@ pub struct ChainBuilder {
     pin_end: bool,
     rest_scale: f32,
     end_load: f32,
+    node_radius: f32,
 }
 
 /// The entities of a spawned chain, from the start node to the end node.
@@ -64,6 +65,7 @@ impl ChainBuilder {
             pin_end: false,
             rest_scale: 1.0,
             end_load: 0.0,
+            node_radius: 0.0,
         }
     }
 
@@ -132,6 +134,15 @@ impl ChainBuilder {
         self
     }
 
+    /// Gives every node a ball collider of `radius` (m; default 0, none), so the rope
+    /// collides with the world's colliders (and with itself where it folds). Below half the
+    /// node spacing, so neighbours do not touch at rest.
+    #[must_use]
+    pub fn node_radius(mut self, radius: f32) -> Self {
+        self.node_radius = radius;
+        self
+    }
+
     /// A load (kg) hung on the end node, added to its mass (0 for none).
     #[must_use]
     pub fn end_load(mut self, kg: f32) -> Self {
@@ -192,7 +203,23 @@ impl ChainBuilder {
                 ParticleBundle::new(x, Vec3::ZERO, self.node_mass)?
             });
         }
-        let nodes: Vec<Entity> = bundles.into_iter().map(|b| world.spawn_one(b)).collect();
+        let radius = non_negative("chain node radius", self.node_radius)?;
+        if radius > 0.0 && 2.0 * radius >= step.length() {
+            return Err(Error::OutOfRange {
+                what: "chain node radius",
+                value: radius,
+                range: "below half the node spacing",
+            });
+        }
+        let nodes: Vec<Entity> = if radius > 0.0 {
+            let ball = crate::collision::Collider::ball(radius)?;
+            bundles
+                .into_iter()
+                .map(|b| world.spawn_one((b, ball.clone())))
+                .collect()
+        } else {
+            bundles.into_iter().map(|b| world.spawn_one(b)).collect()
+        };
         let seg = step.length() * scale;
         let mut chain = Chain {
             nodes,

@@ -2,6 +2,7 @@
 
 mod architecture;
 mod bevy;
+mod character;
 mod cloth;
 mod collision;
 mod common;

@@ -1,14 +1,18 @@
-//! A stack to knock over and a ball to throw: hooke in a windowed Bevy game.
+//! A stack to knock over, a ball to throw and a character to walk: hooke in a windowed Bevy
+//! game.
 //!
+//! - **WASD**: walk the character (a capsule with hooke's `CharacterController`) up the
+//!   stairs, down the ramp, into the crate; **Space**: jump.
 //! - **Left click**: throw a steel ball from the camera towards the cursor.
-//! - **Space**: throw one straight at the stack.
+//! - **T**: throw one straight at the stack.
 //! - **R**: rebuild the stack.
 //! - **G**: show or hide the debug view (colliders, contacts, velocities).
-//! - **Arrow keys**: orbit the camera.
+//! - **Arrow keys**: orbit the camera, which follows the character.
 //!
 //! ```sh
 //! cargo run --release --manifest-path examples/bevy_game/Cargo.toml   # add --ignore-rust-version on Rust < 1.97.1
 //! cargo run --release --manifest-path examples/bevy_game/Cargo.toml -- --debug   # debug view on from the start
+//! cargo run --release --manifest-path examples/bevy_game/Cargo.toml -- --walk    # the character walks +x by itself
 //! ```
 
 // Both preludes glob-imported, warnings denied: hooke's names must not clash with Bevy's.
@@ -17,9 +21,20 @@
 use bevy::prelude::*;
 use hooke::bevy::{PhysicsDebugPlugin, PhysicsGizmos};
 use hooke::prelude::*;
+use hooke::tools::character_scenes::CharacterCourse;
 
 /// Half extent of a crate (m).
 const HALF: f32 = 0.25;
+
+/// Where the character course sits on the floor (m): beside the stack.
+const COURSE: Vec3 = Vec3::new(-7.0, 0.0, 5.0);
+
+/// Walking speed (m/s) and jump speed (m/s: a 0.8 m jump).
+const WALK: f32 = 3.0;
+const JUMP: f32 = 4.0;
+
+#[derive(Component)]
+struct Player;
 
 #[derive(Component)]
 struct Crate;
@@ -72,10 +87,19 @@ fn main() {
         .insert_resource(Look {
             yaw: 0.0,
             pitch: 0.35,
-            distance: 12.0,
+            distance: 10.0,
         })
         .add_systems(Startup, setup)
-        .add_systems(Update, (orbit_camera, throw, rebuild, toggle_debug_view))
+        .add_systems(
+            Update,
+            (
+                steer_player,
+                orbit_camera.after(steer_player),
+                throw,
+                rebuild,
+                toggle_debug_view,
+            ),
+        )
         .run();
 }
 
@@ -99,6 +123,7 @@ fn setup(
     ));
     spawn_stack(&mut commands, &assets)?;
     commands.insert_resource(assets);
+    spawn_course(&mut commands, &mut meshes, &mut materials)?;
     commands.spawn((
         DirectionalLight {
             illuminance: 10_000.0,
@@ -110,7 +135,7 @@ fn setup(
     commands.spawn((Camera3d::default(), Transform::default()));
     commands.spawn((
         Text::new(
-            "left click: throw at the cursor  |  space: throw  |  R: rebuild  |  G: debug view  |  arrows: orbit",
+            "WASD: walk  |  space: jump  |  left click: throw at the cursor  |  T: throw  |  R: rebuild  |  G: debug view  |  arrows: orbit",
         ),
         Node {
             position_type: PositionType::Absolute,
@@ -142,11 +167,81 @@ fn spawn_stack(commands: &mut Commands, assets: &Assets3d) -> Result {
     Ok(())
 }
 
+/// The course of `hooke::tools::character_scenes` (stairs, a landing, a ramp down, a crate,
+/// and a 60° ramp too steep to walk up) and the character at its start.
+fn spawn_course(
+    commands: &mut Commands,
+    meshes: &mut Assets<Mesh>,
+    materials: &mut Assets<StandardMaterial>,
+) -> Result {
+    let course = CharacterCourse::default();
+    let stone = materials.add(Color::srgb(0.6, 0.6, 0.65));
+    for b in course.blocks() {
+        commands.spawn((
+            RigidBody::Static,
+            Collider::cuboid(b.half.x, b.half.y, b.half.z)?,
+            Mesh3d(meshes.add(Cuboid::from_size(2.0 * b.half))),
+            MeshMaterial3d(stone.clone()),
+            Transform::from_translation(COURSE + b.position).with_rotation(b.rotation),
+        ));
+    }
+    commands.spawn((
+        RigidBody::Dynamic,
+        Collider::cuboid(0.5, 0.5, 0.5)?,
+        ColliderDensity::try_new(course.crate_kg)?,
+        Mesh3d(meshes.add(Cuboid::new(1.0, 1.0, 1.0))),
+        MeshMaterial3d(materials.add(Color::srgb(0.8, 0.55, 0.3))),
+        Transform::from_translation(COURSE + course.crate_start()),
+        TransformInterpolation,
+    ));
+    let (half, radius) = course.capsule;
+    commands.spawn((
+        Player,
+        CharacterController::default(),
+        Collider::capsule_y(half, radius)?,
+        Mesh3d(meshes.add(Capsule3d::new(radius, 2.0 * half))),
+        MeshMaterial3d(materials.add(Color::srgb(0.2, 0.45, 0.9))),
+        Transform::from_translation(COURSE + course.character_starts()[0]),
+        TransformInterpolation,
+    ));
+    Ok(())
+}
+
+/// WASD walks the character relative to the camera; space jumps while it is grounded.
+fn steer_player(
+    keys: Res<ButtonInput<KeyCode>>,
+    look: Res<Look>,
+    mut player: Single<(&mut CharacterInput, &CharacterState), With<Player>>,
+) {
+    let (input, state) = &mut *player;
+    let forward = -Vec3::new(look.yaw.sin(), 0.0, look.yaw.cos());
+    let right = Vec3::new(-forward.z, 0.0, forward.x);
+    let mut wish = Vec3::ZERO;
+    for (key, dir) in [
+        (KeyCode::KeyW, forward),
+        (KeyCode::KeyS, -forward),
+        (KeyCode::KeyD, right),
+        (KeyCode::KeyA, -right),
+    ] {
+        if keys.pressed(key) {
+            wish += dir;
+        }
+    }
+    if std::env::args().any(|a| a == "--walk") {
+        wish = Vec3::X;
+    }
+    input.velocity = wish.normalize_or_zero() * WALK;
+    if keys.just_pressed(KeyCode::Space) && state.grounded {
+        input.jump_speed = JUMP;
+    }
+}
+
 fn orbit_camera(
     keys: Res<ButtonInput<KeyCode>>,
     time: Res<Time>,
     mut look: ResMut<Look>,
-    mut camera: Single<&mut Transform, With<Camera3d>>,
+    mut camera: Single<&mut Transform, (With<Camera3d>, Without<Player>)>,
+    player: Single<&Transform, With<Player>>,
 ) {
     let rate = 1.5 * time.delta_secs();
     if keys.pressed(KeyCode::ArrowLeft) {
@@ -161,7 +256,7 @@ fn orbit_camera(
     if keys.pressed(KeyCode::ArrowDown) {
         look.pitch = (look.pitch - rate).max(0.05);
     }
-    let target = Vec3::new(0.0, 1.2, 0.0);
+    let target = player.translation + Vec3::new(0.0, 0.5, 0.0);
     let eye = target
         + look.distance
             * Vec3::new(
@@ -186,7 +281,7 @@ fn throw(
             return Ok(());
         };
         camera.viewport_to_world(eye, cursor)?.direction.as_vec3()
-    } else if keys.just_pressed(KeyCode::Space) {
+    } else if keys.just_pressed(KeyCode::KeyT) {
         (Vec3::new(0.0, 1.0, 0.0) - eye.translation()).normalize()
     } else {
         return Ok(());

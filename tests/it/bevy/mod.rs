@@ -1,6 +1,7 @@
 //! The Bevy layer: App clock, Transform sync, spawning by required components, prelude imports.
 
 mod app;
+mod character_in_app;
 mod debug_view;
 mod preludes;
 mod reflection;

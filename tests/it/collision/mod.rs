@@ -14,6 +14,7 @@ mod fast_spin_stays_above_ground;
 mod landing_stays_in_place;
 mod mesh_contacts;
 mod meshes_leave_deep_overlap_at_a_bounded_speed;
+mod named_layers_and_speed_caps;
 mod no_tunnelling;
 mod node_contacts_never_panic;
 mod prediction_follows_the_gap;

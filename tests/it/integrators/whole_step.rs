@@ -259,6 +259,7 @@ fn every_substep_system_is_replicated_or_blocks_the_path() {
         "hooke::particles::plugin::advect_tracers",  // Tracer
         "hooke::rigid::plugin::apply_angular_damping", // AngularDamping
         "hooke::rigid::plugin::apply_forces_at_points", // ExternalForceAtPoint
+        "hooke::rigid::limits::limit_speeds",        // MaxLinearSpeed, MaxAngularSpeed
         "hooke::springs::plugin::apply_spring_forces", // Spring
         "hooke::springs::plugin::apply_network_forces", // SpringNetwork
         "hooke::springs::entity_implicit::solve_entity_springs", // Spring

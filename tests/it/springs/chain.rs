@@ -251,3 +251,65 @@ fn a_taut_strings_transverse_waves_travel_at_the_square_root_of_tension_over_den
     println!("pulse speed {speed:.3} m/s, √(T/μ) = {c:.3} m/s ({substeps} substeps)");
     assert!((speed / c - 1.0).abs() < 0.02, "{speed} vs {c}");
 }
+
+/// A slack rope with `node_radius` drapes over a bar instead of sagging through it: pinned
+/// at both ends 0.3 m above a static bar, its nodes over the bar rest on the bar's top;
+/// without a radius they sag through; a radius of half the spacing is a typed error.
+#[test]
+fn a_rope_with_a_node_radius_drapes_over_a_bar() {
+    let mut w = world();
+    let bar = w
+        .spawn((
+            RigidBody::Static,
+            Collider::cuboid(0.1, 0.1, 1.0).unwrap(),
+            Position::from(Vec3::new(0.0, 0.0, 0.0)),
+        ))
+        .id();
+    let build = |r: f32| {
+        ChainBuilder::rope(Vec3::new(-1.0, 0.3, 0.0), Vec3::new(1.0, 0.3, 0.0), 21)
+            .stiffness(500.0)
+            .pin_end(true)
+            .rest_scale(1.3)
+            .node_radius(r)
+    };
+    let rope = build(0.04).spawn(&mut w).unwrap();
+    for _ in 0..300 {
+        w.step_physics();
+    }
+    let top = 0.1;
+    for &n in &rope.nodes {
+        let x = w.get::<Position>(n).unwrap().get();
+        assert!(x.is_finite());
+        if x.x.abs() < 0.1 {
+            assert!(x.y > top + 0.03, "node over the bar sank to {x}");
+        }
+    }
+    let _ = bar;
+    let without = ChainBuilder::rope(Vec3::new(-1.0, 0.3, 5.0), Vec3::new(1.0, 0.3, 5.0), 21)
+        .stiffness(500.0)
+        .pin_end(true)
+        .rest_scale(1.3)
+        .spawn(&mut w)
+        .unwrap();
+    for _ in 0..300 {
+        w.step_physics();
+    }
+    let lowest_over_bar = without
+        .nodes
+        .iter()
+        .map(|&n| w.get::<Position>(n).unwrap().get())
+        .filter(|x| x.x.abs() < 0.1)
+        .map(|x| x.y)
+        .fold(f32::MAX, f32::min);
+    assert!(
+        lowest_over_bar < top - 0.1,
+        "without a radius it sags through: {lowest_over_bar}"
+    );
+    assert!(matches!(
+        build(0.05).spawn(&mut w),
+        Err(Error::OutOfRange {
+            what: "chain node radius",
+            ..
+        })
+    ));
+}
