@@ -12,7 +12,7 @@
 //! ```sh
 //! cargo run --release --manifest-path examples/bevy_game/Cargo.toml   # add --ignore-rust-version on Rust < 1.97.1
 //! cargo run --release --manifest-path examples/bevy_game/Cargo.toml -- --debug   # debug view on from the start
-//! cargo run --release --manifest-path examples/bevy_game/Cargo.toml -- --walk    # the character walks +x by itself
+//! cargo run --release --manifest-path examples/bevy_game/Cargo.toml -- --walk    # the character walks the course by itself
 //! ```
 
 // Both preludes glob-imported, warnings denied: hooke's names must not clash with Bevy's.
@@ -211,9 +211,9 @@ fn spawn_course(
 fn steer_player(
     keys: Res<ButtonInput<KeyCode>>,
     look: Res<Look>,
-    mut player: Single<(&mut CharacterInput, &CharacterState), With<Player>>,
+    mut player: Single<(&mut CharacterInput, &CharacterState, &Transform), With<Player>>,
 ) {
-    let (input, state) = &mut *player;
+    let (input, state, at) = &mut *player;
     let forward = -Vec3::new(look.yaw.sin(), 0.0, look.yaw.cos());
     let right = Vec3::new(-forward.z, 0.0, forward.x);
     let mut wish = Vec3::ZERO;
@@ -227,7 +227,8 @@ fn steer_player(
             wish += dir;
         }
     }
-    if std::env::args().any(|a| a == "--walk") {
+    // `--walk`: along the course to the crate and on, stopping short of the floor's edge.
+    if std::env::args().any(|a| a == "--walk") && at.translation.x < 12.0 {
         wish = Vec3::X;
     }
     input.velocity = wish.normalize_or_zero() * WALK;
