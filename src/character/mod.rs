@@ -72,7 +72,8 @@ use crate::core::quarantine::{Validate, validate_on_insert};
 use crate::rigid::RigidBody;
 
 /// A kinematic character moved by [`CharacterInput`] with move-and-slide. Needs a
-/// [`Collider`](crate::collision::Collider) on the same entity.
+/// [`Collider`](crate::collision::Collider) on the same entity; brings
+/// [`RigidBody::Kinematic`] along (on a body given another kind it does not move it).
 #[derive(Component, Debug, Clone, PartialEq)]
 #[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(RigidBody = RigidBody::Kinematic, CharacterInput, CharacterState)]
