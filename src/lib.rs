@@ -50,6 +50,7 @@
 //! | feature | default | what |
 //! |---|---|---|
 //! | `bevy` | off | `bevy_app`, `bevy_time`, `bevy_transform`, `bevy_diagnostic` 0.20: the `bevy` module |
+//! | `collider-from-mesh` | off | `bevy_mesh` 0.20: colliders from a `Mesh` (`Collider::trimesh_from_mesh`, ...) |
 //!
 //! ## Spawning
 //!
@@ -166,6 +167,10 @@ pub mod tools;
 
 /// parry, re-exported so custom shapes ([`Collider::new`](crate::collision::Collider::new)) need no second dependency.
 pub use parry3d;
+
+/// `bevy_mesh`, re-exported for building the meshes colliders are made from.
+#[cfg(feature = "collider-from-mesh")]
+pub use bevy_mesh;
 
 pub use crate::core::error::{Error, Result};
 pub use crate::plugins::{PhysicsPlugins, PhysicsWorldExt};

@@ -61,6 +61,8 @@ mod attach;
 pub(crate) mod broad_phase;
 mod casters;
 pub mod coincident;
+#[cfg(feature = "collider-from-mesh")]
+mod from_mesh;
 pub(crate) mod lanes;
 mod layers;
 pub(crate) mod narrow_phase;

@@ -141,6 +141,10 @@ pub enum Error {
     /// An error read back from a snapshot (the message of the error it was).
     #[error("{0}")]
     Restored(String),
+
+    /// A Bevy mesh a collider cannot be made from (feature `collider-from-mesh`).
+    #[error("cannot make a collider from {0}")]
+    UnsupportedMesh(String),
 }
 
 /// Shorthand for hooke results.

@@ -3,6 +3,7 @@
 mod box3d_scenes_stand_and_settle;
 mod broad_phase_hears_pose_changes;
 mod collider_parts_are_never_lost_or_nan;
+mod colliders_from_meshes;
 mod compound_part_frames;
 mod contacts_against_closed_forms;
 mod contacts_end_with_the_last_collider;
