@@ -189,14 +189,20 @@ pub mod prelude {
     pub use crate::character::CharacterInput;
     pub use crate::character::CharacterState;
     pub use crate::cloth::ClothBuilder;
+    pub use crate::collision::ActiveCollisionHooks;
     pub use crate::collision::Collider;
     pub use crate::collision::ColliderDensity;
     pub use crate::collision::ColliderOf;
     pub use crate::collision::ColliderOffset;
     pub use crate::collision::CollisionEventsEnabled;
+    pub use crate::collision::CollisionHooks;
+    pub use crate::collision::CollisionHooksPlugin;
     pub use crate::collision::CollisionLayers;
+    pub use crate::collision::ContactEdit;
     pub use crate::collision::ContactEnd;
     pub use crate::collision::ContactEnded;
+    pub use crate::collision::ContactReport;
+    pub use crate::collision::ContactReporting;
     pub use crate::collision::ContactStart;
     pub use crate::collision::ContactStarted;
     pub use crate::collision::Contacts;
@@ -246,6 +252,7 @@ pub mod prelude {
     pub use crate::rigid::AngularVelocity;
     pub use crate::rigid::BodyForces;
     pub use crate::rigid::CenterOfMass;
+    pub use crate::rigid::Dominance;
     pub use crate::rigid::Inertia;
     pub use crate::rigid::MassProperties;
     pub use crate::rigid::MaxAngularSpeed;

@@ -92,6 +92,15 @@ impl WorldPlugin for SleepPlugin {
                 .run_if(any_with_component::<Sleeping>)
                 .in_set(CollisionSystems::Wake),
         );
+        world.add_observer(restart_stillness);
+    }
+}
+
+/// However a body wakes (game code removing [`Sleeping`] included), it counts its stillness
+/// afresh: with the old count it fell straight back asleep in the next step.
+fn restart_stillness(woken: On<Remove<Sleeping>>, mut timers: Query<&mut SleepTimer>) {
+    if let Ok(mut timer) = timers.get_mut(woken.entity) {
+        timer.0 = 0.0;
     }
 }
 

@@ -143,6 +143,7 @@ fn register_messages(world: &mut World) {
     // may have created it already.
     MessageRegistry::register_message::<ContactStarted>(world);
     MessageRegistry::register_message::<ContactEnded>(world);
+    MessageRegistry::register_message::<crate::collision::ContactReport>(world);
     MessageRegistry::register_message::<BodyQuarantined>(world);
     MessageRegistry::register_message::<crate::joints::JointBroken>(world);
     MessageRegistry::register_message::<crate::integrator::StabilityWarning>(world);
@@ -221,6 +222,17 @@ bevy_plugin!(
     ClothPlugin,
     CharacterControllerPlugin
 );
+
+impl<H: crate::collision::CollisionHooks + 'static> Plugin
+    for crate::collision::CollisionHooksPlugin<H>
+where
+    for<'w, 's> bevy_ecs::system::SystemParamItem<'w, 's, H>: crate::collision::CollisionHooks,
+{
+    fn build(&self, app: &mut App) {
+        register_messages(app.world_mut());
+        app.world_mut().add_physics(Self::default());
+    }
+}
 
 /// `app.add_plugins(PhysicsPlugins)`: the clock ([`PhysicsSchedulePlugin`]), every effect,
 /// [`PhysicsTransformPlugin`] and [`PhysicsInterpolationPlugin`]. Change one with

@@ -63,6 +63,7 @@ mod casters;
 pub mod coincident;
 #[cfg(feature = "collider-from-mesh")]
 mod from_mesh;
+pub(crate) mod hooks;
 pub(crate) mod lanes;
 mod layers;
 pub(crate) mod narrow_phase;
@@ -71,17 +72,22 @@ mod plugin;
 pub(crate) mod prefetch;
 mod query;
 pub(crate) mod radii;
+mod reports;
 pub(crate) mod slots;
 pub(crate) mod solver;
 pub(crate) mod support;
 
 pub(crate) use attach::OwnShape;
 pub use attach::{ColliderDensity, ColliderOf, ColliderOffset, MAX_PART_DEPTH};
+pub use hooks::{
+    ActiveCollisionHooks, CollisionHookSystems, CollisionHooks, CollisionHooksPlugin, ContactEdit,
+};
 pub use layers::{CollisionLayers, LayerMask, PhysicsLayer};
 pub(crate) use narrow_phase::ContactsRecord;
 pub use narrow_phase::{ContactPair, Contacts};
 pub(crate) use nodes::coupling::NodeImpulse;
 pub use plugin::CollisionPlugin;
+pub use reports::{ContactReport, ContactReporting, ReportedPoint};
 
 /// Pairs of bodies that never collide, whatever their layers; each pair counts its reasons
 /// (a joint between the two is one, see [`crate::joints`]), and collides again when none is

@@ -19,6 +19,16 @@ pub struct CollisionPlugin;
 impl WorldPlugin for CollisionPlugin {
     fn build(&self, world: &mut World) {
         crate::core::restore::init::<ContactSettings>(world);
+        crate::core::schedule::configure_sets(
+            world,
+            PhysicsSchedule,
+            (
+                super::hooks::CollisionHookSystems::FilterPairs,
+                super::hooks::CollisionHookSystems::ModifyContacts,
+            )
+                .chain()
+                .in_set(CollisionSystems::Detect),
+        );
         crate::collision::solver::whole_step::install(world);
         add_own_systems(
             world,
@@ -37,6 +47,8 @@ impl WorldPlugin for CollisionPlugin {
         crate::core::restore::init::<ContactSolver>(world);
         crate::core::plugin::add_message::<ContactStarted>(world);
         crate::core::plugin::add_message::<ContactEnded>(world);
+        crate::core::plugin::add_message::<super::ContactReport>(world);
+        crate::core::quarantine::validate_writes::<super::ContactReporting>(world);
         // Impulses from mesh nodes (soft bodies, cloth) reach their bodies at the start of the
         // next substep, before the bodies' own integrators.
         add_own_systems(
@@ -60,6 +72,8 @@ impl WorldPlugin for CollisionPlugin {
             (
                 super::casters::update_ray_hits.run_if(any_with_component::<super::RayCaster>),
                 super::casters::update_shape_hits.run_if(any_with_component::<super::ShapeCaster>),
+                super::reports::write_contact_reports
+                    .run_if(any_with_component::<super::ContactReporting>),
             )
                 .after(super::attach::place_attached_colliders)
                 .in_set(crate::core::schedule::FinishSystems::Writeback),
@@ -80,8 +94,11 @@ impl WorldPlugin for CollisionPlugin {
                     super::broad_phase::plugin::update_moving_aabbs,
                     super::broad_phase::plugin::update_fixed_aabbs
                         .run_if(super::broad_phase::plugin::fixed_dirty),
-                    super::broad_phase::plugin::run_broad_phase,
-                    super::narrow_phase::plugin::update_contacts,
+                    super::broad_phase::plugin::run_broad_phase
+                        .before(super::hooks::CollisionHookSystems::FilterPairs),
+                    super::narrow_phase::plugin::update_contacts
+                        .after(super::hooks::CollisionHookSystems::FilterPairs)
+                        .before(super::hooks::CollisionHookSystems::ModifyContacts),
                     super::narrow_phase::plugin::trigger_contact_events
                         .run_if(any_with_component::<super::CollisionEventsEnabled>),
                 )

@@ -420,3 +420,15 @@ pub fn add_systems<M>(
         .get_resource_or_init::<Schedules>()
         .add_systems(label, systems);
 }
+
+/// Configures system sets of one schedule (an effect's own sets, placed inside the
+/// kernel's).
+pub(crate) fn configure_sets<M>(
+    world: &mut World,
+    label: impl ScheduleLabel,
+    sets: impl IntoScheduleConfigs<bevy_ecs::schedule::InternedSystemSet, M>,
+) {
+    world
+        .get_resource_or_init::<Schedules>()
+        .configure_sets(label, sets);
+}

@@ -39,11 +39,13 @@
 //! [`KinematicTarget`]. [`RigidBody::Static`] bodies have no mass components at all, so no
 //! physics system ever visits them.
 
+pub(crate) mod dominance;
 mod forces;
 mod limits;
 mod mass;
 mod plugin;
 
+pub use dominance::Dominance;
 pub use forces::BodyForces;
 pub use limits::{MaxAngularSpeed, MaxLinearSpeed, speed_scale};
 pub(crate) use mass::{ComputedMass, insert_computed_mass};

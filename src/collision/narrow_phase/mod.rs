@@ -1,6 +1,7 @@
 //! Narrow phase: persistent contact manifolds per pair, and the contact query API.
 
 pub(crate) mod ccd;
+pub(crate) mod decisions;
 pub(crate) mod fetch;
 pub(crate) mod pairs;
 pub(crate) mod plugin;
@@ -341,6 +342,14 @@ impl Contacts {
         }
         p.normal = pose_of_lower.rotation * p.normal;
         Some(p)
+    }
+
+    /// The slot and state of the pair `(a, b)` (lower entity first) if the solver has points
+    /// of it to take: not a sensor pair, and some manifold with points.
+    pub(crate) fn solvable(&self, a: Entity, b: Entity) -> Option<(u32, &PairState)> {
+        let slot = self.pairs.slot(&(a, b))?;
+        let state = self.pairs.at(slot)?;
+        (!state.sensor && state.solved().any(|m| !m.points.is_empty())).then_some((slot, state))
     }
 
     /// Pairs whose boxes overlap (touching or not).

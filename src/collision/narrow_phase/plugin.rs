@@ -426,6 +426,7 @@ pub(crate) fn update_contacts(
     sleeping: Query<(), With<Sleeping>>,
     mut buffers: Local<NarrowBuffers>,
     mut commands: Commands,
+    hooks: Option<Res<crate::collision::narrow_phase::decisions::HookDecisions>>,
 ) {
     let (wanted, pair_slots, scratch, known) = &mut *buffers;
     if known.pairs != Some(bp.pairs_stamp())
@@ -502,6 +503,18 @@ pub(crate) fn update_contacts(
             };
             state.sensor = sensor;
             state.cast = None;
+            if hooks.as_ref().is_some_and(|h| h.rejects(a, b)) {
+                // A filter hook turned the pair away: no contact, and the next contact it
+                // is allowed starts cold.
+                state.manifolds.clear();
+                state.workspace = None;
+                state.recycle = None;
+                if state.touching {
+                    state.touching = false;
+                    ended.write(ContactEnded { a, b });
+                }
+                continue;
+            }
             // parry can still panic on shapes at the edge of its domain (EPA's index panic was
             // seen on huge or badly turned shapes): each parry call is guarded, and one bad pair
             // loses its contact and its moving sides are quarantined while the step goes on.

@@ -122,6 +122,7 @@ impl ContactSolver {
             restitution: scalar(|m| m.restitution),
             threshold: scalar(|m| -m.threshold),
             fixed: F4::new(fixed.map(|f| if f { f32::from_bits(!0) } else { 0.0 })),
+            held: std::array::from_fn(|l| lane(l).map_or(0, |m| m.held)),
         };
         if batch.bouncy() {
             batch.tracked = self.tracks.len() as u32;

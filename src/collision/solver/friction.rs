@@ -33,6 +33,8 @@ pub(super) struct Friction {
     radius: F4,
     imp: [F4; 2],
     twist_imp: F4,
+    /// The relative tangential velocity aimed for, per tangent (zero but on a conveyor).
+    target: [F4; 2],
 }
 
 impl Friction {
@@ -52,6 +54,7 @@ impl Friction {
             radius: scalar(|m| m.radius),
             imp: [scalar(|m| m.t_imp[0]), scalar(|m| m.t_imp[1])],
             twist_imp: scalar(|m| m.twist),
+            target: [scalar(|m| m.surface[0]), scalar(|m| m.surface[1])],
             ..Self::default()
         }
     }
@@ -92,7 +95,10 @@ impl Friction {
     pub fn solve(&mut self, batch: &Batch, normal: F4, a: &mut Side, b: &mut Side) {
         let limit = batch.friction * normal;
         let rel = Side::relative(a, b, self.r_a, self.r_b);
-        let dv = [batch.t[0].dot(rel), batch.t[1].dot(rel)];
+        let dv = [
+            batch.t[0].dot(rel) - self.target[0],
+            batch.t[1].dot(rel) - self.target[1],
+        ];
         let old = self.imp;
         let [k0, k1, k2] = self.k_inv;
         let new = [

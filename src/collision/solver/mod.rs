@@ -153,6 +153,12 @@ pub(crate) struct ManifoldConstraint {
     /// Warm-start friction impulses: along the two tangents, and the twist about n.
     pub t_imp: [f32; 2],
     pub twist: f32,
+    /// The relative tangential velocity friction drives the manifold to, along each
+    /// tangent (m/s; zero but for a conveyor's surface, see [`crate::collision::ContactEdit`]).
+    pub surface: [f32; 2],
+    /// The sides that take no impulse from this manifold for [`crate::rigid::Dominance`]:
+    /// bit 0 `a`, bit 1 `b`.
+    pub held: u8,
 }
 
 /// One contact point as the narrow phase gave it.
@@ -276,6 +282,8 @@ struct Batch {
     threshold: F4,
     /// All-ones in lanes where one side is static: they use the stiffer static softness.
     fixed: F4,
+    /// Per lane, its manifold's [`ManifoldConstraint::held`] sides.
+    held: [u8; 4],
 }
 
 impl Batch {
@@ -332,6 +340,10 @@ pub(crate) struct ContactSolver {
     turned_mark: Vec<bool>,
     /// Per manifold, its impulses at the end of the step (see [`write_back`]).
     solved: Vec<write_back::Solved>,
+    /// Some collider asks for [`crate::collision::ContactReport`]s: the substeps add up
+    /// each manifold's impulses into `totals`.
+    pub reporting: bool,
+    totals: Vec<write_back::Solved>,
 }
 
 /// Solver index per entity.
@@ -503,6 +515,7 @@ impl ContactSolver {
         self.tracks.clear();
         self.friction.clear();
         self.turned.clear();
+        self.totals.clear();
     }
 
     /// Index of the rest state (static sides, empty lanes).
@@ -516,14 +529,25 @@ impl ContactSolver {
     fn compute_axes(&mut self, bi: usize) {
         const ZERO: Mat3A = Mat3A::ZERO;
         let batch = self.batches[bi];
-        let body = |i: u32| self.bodies.get(i as usize);
-        let inv_m = |ix: [u32; 4]| F4::new(ix.map(|i| body(i).map_or(0.0, |b| b.inv_mass)));
-        let inv_i = |ix: [u32; 4]| M3::from_lanes(ix.map(|i| body(i).map_or(&ZERO, |b| &b.inv_i)));
+        // A side held for dominance reads as immovable, like a kinematic body.
+        let held = batch.held;
+        let body =
+            |l: usize, i: u32, bit: u8| self.bodies.get(i as usize).filter(|_| held[l] & bit == 0);
+        let inv_m = |ix: [u32; 4], bit: u8| {
+            F4::new(std::array::from_fn(|l| {
+                body(l, ix[l], bit).map_or(0.0, |b| b.inv_mass)
+            }))
+        };
+        let inv_i = |ix: [u32; 4], bit: u8| {
+            M3::from_lanes(std::array::from_fn(|l| {
+                body(l, ix[l], bit).map_or(&ZERO, |b| &b.inv_i)
+            }))
+        };
         let (ma, mb, ia, ib) = (
-            inv_m(batch.a),
-            inv_m(batch.b),
-            inv_i(batch.a),
-            inv_i(batch.b),
+            inv_m(batch.a, 1),
+            inv_m(batch.b, 2),
+            inv_i(batch.a, 1),
+            inv_i(batch.b, 2),
         );
         let counts = batch
             .lanes

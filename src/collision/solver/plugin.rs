@@ -86,6 +86,9 @@ pub(crate) fn relax_pass(
         solver.restitution();
     }
     solver.limit_deep_speed(settings.max_push_velocity);
+    if solver.reporting {
+        solver.add_substep_totals();
+    }
     if time.is_last() {
         solver.for_each_solved(|solved, ahead| {
             if let Some(slot) = ahead {

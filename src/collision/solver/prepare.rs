@@ -36,6 +36,7 @@ type PreparedBody<'a> = (
     &'a Restitution,
     Option<&'a RestitutionThreshold>,
     Has<Sleeping>,
+    Option<&'a crate::rigid::Dominance>,
 );
 
 /// One side of the step's contacts as constraint building needs it, fetched once per step
@@ -68,6 +69,8 @@ pub(crate) struct Side {
     /// A material written with a bad value (through `get_mut`): the body is quarantined and
     /// this step's contacts use the defaults.
     bad_material: Option<crate::core::error::Error>,
+    /// Its [`crate::rigid::Dominance`] group.
+    dominance: i8,
 }
 
 impl Side {
@@ -88,6 +91,7 @@ impl Side {
             restitution,
             threshold,
             sleeping,
+            dominance,
         ) = body;
         // Checked where they are used, once per body in contact: a pass over every
         // collider's `Changed` materials cost 16–36 µs a step among 10,000 idle statics.
@@ -127,6 +131,7 @@ impl Side {
             moves: v.is_some() && !sleeping,
             inertia: inertia.copied(),
             bad_material,
+            dominance: dominance.map_or(0, |d| d.0),
         }
     }
 }
@@ -249,8 +254,10 @@ fn tangent_basis(
     centre: Vec3A,
     (xa, va, wa): (Vec3A, Vec3A, Vec3A),
     (xb, vb, wb): (Vec3A, Vec3A, Vec3A),
+    surface: Vec3A,
 ) -> [Vec3A; 2] {
-    let slide = (vb + wb.cross(centre - xb)) - (va + wa.cross(centre - xa));
+    // Sliding is measured against the surfaces' own motion (a conveyor belt's).
+    let slide = (vb + wb.cross(centre - xb)) - (va + wa.cross(centre - xa)) - surface;
     let impulse = Vec3A::from(m.data.tangent);
     let normal = crate::collision::narrow_phase::points::kept_normal_impulse(m);
     let along = |v: Vec3A| (v - n * n.dot(v)).try_normalize();
@@ -273,9 +280,12 @@ pub(crate) fn prepare_contacts(
     bodies: Query<PreparedBody, (With<Collider>, ContactFilter)>,
     mut buffers: Local<PrepareBuffers>,
     mut commands: Commands,
+    hooks: Option<Res<crate::collision::narrow_phase::decisions::HookDecisions>>,
+    reporting: Query<(), With<crate::collision::ContactReporting>>,
 ) {
     let s = &mut *solver;
     s.clear();
+    s.reporting = !reporting.is_empty();
     let touch = 0.25 * settings.margin;
     let (wanted, pairs, sides) = &mut *buffers;
     wanted.clear();
@@ -286,15 +296,9 @@ pub(crate) fn prepare_contacts(
         pairs.push((slot, wanted.slot(a) as u32, wanted.slot(b) as u32));
     }
     for &(a, b) in &contacts.woken {
-        let Some(slot) = contacts.pairs.slot(&(a, b)) else {
+        let Some((slot, _)) = contacts.solvable(a, b) else {
             continue;
         };
-        let Some(state) = contacts.pairs.at(slot) else {
-            continue;
-        };
-        if state.sensor || state.solved().all(|m| m.points.is_empty()) {
-            continue;
-        }
         pairs.push((slot, wanted.slot(a) as u32, wanted.slot(b) as u32));
     }
     sides.clear();
@@ -336,10 +340,27 @@ pub(crate) fn prepare_contacts(
             continue;
         };
         let ((va, wa), (vb, wb)) = ((a.v, a.w), (b.v, b.w));
-        let friction = settings.friction_rule.combine(a.friction, b.friction);
-        let restitution = settings
+        let mut friction = settings.friction_rule.combine(a.friction, b.friction);
+        let mut restitution = settings
             .restitution_rule
             .combine(a.restitution, b.restitution);
+        // Dominance only between two dynamic bodies: static and kinematic ones take no
+        // impulse anyway, and a dominant body must still stand on the ground.
+        let dynamic = |i: u32| s.bodies.get(i as usize).is_some_and(|b| b.dynamic);
+        let held = if dynamic(ia) && dynamic(ib) {
+            crate::rigid::dominance::held_sides(a.dominance, b.dominance)
+        } else {
+            0
+        };
+        let mut surface = Vec3A::ZERO;
+        if let Some(edit) = hooks.as_ref().and_then(|h| h.edit(slot)) {
+            if !edit.enabled {
+                continue;
+            }
+            friction = edit.friction.unwrap_or(friction);
+            restitution = edit.restitution.unwrap_or(restitution);
+            surface = edit.surface;
+        }
         // The lower of the two colliders' own thresholds, else the world's.
         let threshold = match (a.threshold, b.threshold) {
             (Some(x), Some(y)) => x.min(y),
@@ -368,6 +389,7 @@ pub(crate) fn prepare_contacts(
                 a.x + Vec3A::from(f.centre[0]),
                 (a.x, va, wa),
                 (b.x, vb, wb),
+                surface,
             );
             for (&k, arms) in kept.iter().zip(&f.arms) {
                 let p = &m.points[usize::from(k)];
@@ -422,6 +444,8 @@ pub(crate) fn prepare_contacts(
                 radius: f.radius,
                 t_imp: [tangent.dot(t[0]), tangent.dot(t[1])],
                 twist: m.data.twist,
+                surface: [surface.dot(t[0]), surface.dot(t[1])],
+                held,
             });
         }
     }

@@ -74,6 +74,8 @@ fn solver_with(bodies: usize, pairs: &[(u32, u32)]) -> ContactSolver {
             radius: 0.0,
             t_imp: [0.0; 2],
             twist: 0.0,
+            surface: [0.0; 2],
+            held: 0,
         });
         s.inputs.push(PointInput {
             base: -0.01,

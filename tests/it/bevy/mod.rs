@@ -2,6 +2,7 @@
 
 mod app;
 mod character_in_app;
+mod collision_hooks_and_reports_in_app;
 mod debug_view;
 mod preludes;
 mod reflection;

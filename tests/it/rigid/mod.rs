@@ -1,5 +1,6 @@
 //! Rigid bodies: torque-free motion, mass properties from shapes, and a cross-check with rapier.
 
+mod dominance_pushes_without_being_pushed;
 mod forces_without_inserting_first;
 mod mass;
 mod rapier_crosscheck;
