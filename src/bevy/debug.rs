@@ -276,7 +276,8 @@ fn draw_contacts(
     {
         return;
     }
-    let dt = time.map_or(1.0 / 60.0, |t| t.dt());
+    // A pair's normal impulse is its last substep's: the force times the substep.
+    let h = time.map_or(1.0 / 240.0, |t| t.substep_dt());
     for (a, b) in contacts.touching() {
         let Ok((x, q, com)) = bodies.get(a) else {
             continue;
@@ -296,7 +297,7 @@ fn draw_contacts(
             let centre = pair.points.iter().sum::<Vec3>() / pair.points.len() as f32;
             let length = match config.contact_normal_scale {
                 ContactGizmoScale::Constant(l) => l,
-                ContactGizmoScale::Force(s) => (s * pair.normal_impulse / dt).max(0.01),
+                ContactGizmoScale::Force(s) => (s * pair.normal_impulse / h).max(0.01),
             };
             gizmos.arrow(centre, centre + length * pair.normal, colour);
         }

@@ -266,7 +266,9 @@ pub struct ContactPair {
     pub normal: Vec3,
     /// Deepest penetration (m, positive when overlapping).
     pub depth: f32,
-    /// Total normal impulse of the last step (N·s): the contact force times dt.
+    /// Total normal impulse of the step's last substep (N·s): the contact force times the
+    /// substep, [`crate::core::time::PhysicsTime::substep_dt`]. For the whole step's
+    /// impulses, summed over its substeps, see [`crate::collision::ContactReport`].
     pub normal_impulse: f32,
     /// Whether one of the two is a sensor (no impulses then).
     pub sensor: bool,

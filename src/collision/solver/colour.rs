@@ -122,7 +122,10 @@ impl ContactSolver {
             restitution: scalar(|m| m.restitution),
             threshold: scalar(|m| -m.threshold),
             fixed: F4::new(fixed.map(|f| if f { f32::from_bits(!0) } else { 0.0 })),
-            held: std::array::from_fn(|l| lane(l).map_or(0, |m| m.held)),
+            held: match self.edited {
+                true => (0..4).fold(0, |h, l| h | lane(l).map_or(0, |m| m.held & 3) << (2 * l)),
+                false => 0,
+            },
         };
         if batch.bouncy() {
             batch.tracked = self.tracks.len() as u32;
@@ -163,7 +166,7 @@ impl ContactSolver {
             });
         }
         self.friction
-            .push(friction::Friction::new(&self.manifolds, chunk));
+            .push(friction::Friction::new(&self.manifolds, chunk, self.edited));
         self.batches.push(batch);
         self.compute_axes(self.batches.len() - 1);
     }

@@ -39,8 +39,9 @@ pub(super) struct Friction {
 
 impl Friction {
     /// The lanes' lever arms, radii and warm-start impulses (masses come with
-    /// [`Self::compute`]).
-    pub fn new(manifolds: &[ManifoldConstraint], chunk: &[u32]) -> Self {
+    /// [`Self::compute`]); their surface velocities when some manifold of the step has one
+    /// (`edited`).
+    pub fn new(manifolds: &[ManifoldConstraint], chunk: &[u32], edited: bool) -> Self {
         let lane = |l: usize| chunk.get(l).map(|&mi| &manifolds[mi as usize]);
         let vector = |f: fn(&ManifoldConstraint) -> Vec3A| {
             V3::from_lanes(std::array::from_fn(|l| lane(l).map_or(Vec3A::ZERO, f)))
@@ -54,7 +55,10 @@ impl Friction {
             radius: scalar(|m| m.radius),
             imp: [scalar(|m| m.t_imp[0]), scalar(|m| m.t_imp[1])],
             twist_imp: scalar(|m| m.twist),
-            target: [scalar(|m| m.surface[0]), scalar(|m| m.surface[1])],
+            target: match edited {
+                true => [scalar(|m| m.surface[0]), scalar(|m| m.surface[1])],
+                false => [F4::ZERO; 2],
+            },
             ..Self::default()
         }
     }

@@ -282,8 +282,8 @@ struct Batch {
     threshold: F4,
     /// All-ones in lanes where one side is static: they use the stiffer static softness.
     fixed: F4,
-    /// Per lane, its manifold's [`ManifoldConstraint::held`] sides.
-    held: [u8; 4],
+    /// Its lanes' [`ManifoldConstraint::held`] sides, two bits per lane (lane l at bit 2l).
+    held: u8,
 }
 
 impl Batch {
@@ -344,6 +344,9 @@ pub(crate) struct ContactSolver {
     /// each manifold's impulses into `totals`.
     pub reporting: bool,
     totals: Vec<write_back::Solved>,
+    /// Some manifold of the step has a side held for dominance or a surface velocity: only
+    /// then are those read into the batches.
+    pub edited: bool,
 }
 
 /// Solver index per entity.
@@ -516,6 +519,7 @@ impl ContactSolver {
         self.friction.clear();
         self.turned.clear();
         self.totals.clear();
+        self.edited = false;
     }
 
     /// Index of the rest state (static sides, empty lanes).
@@ -529,26 +533,25 @@ impl ContactSolver {
     fn compute_axes(&mut self, bi: usize) {
         const ZERO: Mat3A = Mat3A::ZERO;
         let batch = self.batches[bi];
-        // A side held for dominance reads as immovable, like a kinematic body.
-        let held = batch.held;
-        let body =
-            |l: usize, i: u32, bit: u8| self.bodies.get(i as usize).filter(|_| held[l] & bit == 0);
-        let inv_m = |ix: [u32; 4], bit: u8| {
-            F4::new(std::array::from_fn(|l| {
-                body(l, ix[l], bit).map_or(0.0, |b| b.inv_mass)
-            }))
+        let body = |i: u32| self.bodies.get(i as usize);
+        let inv_m = |ix: [u32; 4]| F4::new(ix.map(|i| body(i).map_or(0.0, |b| b.inv_mass)));
+        let inv_i = |ix: [u32; 4]| M3::from_lanes(ix.map(|i| body(i).map_or(&ZERO, |b| &b.inv_i)));
+        // A side held for dominance reads as immovable, like a kinematic body: its lanes
+        // point at the rest state's index, which has no solver body.
+        let (a, b) = match batch.held {
+            0 => (batch.a, batch.b),
+            held => {
+                let rest = self.rest();
+                let keep = |ix: [u32; 4], bit: u8| {
+                    std::array::from_fn(|l| match held >> (2 * l) & bit {
+                        0 => ix[l],
+                        _ => rest,
+                    })
+                };
+                (keep(batch.a, 1), keep(batch.b, 2))
+            }
         };
-        let inv_i = |ix: [u32; 4], bit: u8| {
-            M3::from_lanes(std::array::from_fn(|l| {
-                body(l, ix[l], bit).map_or(&ZERO, |b| &b.inv_i)
-            }))
-        };
-        let (ma, mb, ia, ib) = (
-            inv_m(batch.a, 1),
-            inv_m(batch.b, 2),
-            inv_i(batch.a, 1),
-            inv_i(batch.b, 2),
-        );
+        let (ma, mb, ia, ib) = (inv_m(a), inv_m(b), inv_i(a), inv_i(b));
         let counts = batch
             .lanes
             .map(|mi| self.manifolds.get(mi as usize).map_or(0, |m| m.count));

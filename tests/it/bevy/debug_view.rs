@@ -317,3 +317,34 @@ fn the_debug_view_draws_each_part_where_it_is_and_each_toggle_removes_it() {
         assert!(drawn(&app, colour).is_empty(), "{colour:?} still drawn");
     }
 }
+
+#[test]
+fn force_scaled_contact_arrows_are_as_long_as_the_weight_they_carry() {
+    // A 2 kg box resting on the ground: with arrows of 0.05 m per newton, its normal is
+    // 0.05 × m g = 0.981 m long (the pair's impulse is its last substep's, over h).
+    let mut app = app();
+    config(&mut app).contact_normal_scale = hooke::bevy::ContactGizmoScale::Force(0.05);
+    let world = app.world_mut();
+    world.spawn((
+        RigidBody::Static,
+        Collider::cuboid(5.0, 0.5, 5.0).unwrap(),
+        Transform::from_xyz(0.0, -0.5, 0.0),
+    ));
+    world.spawn((
+        RigidBody::Dynamic,
+        Collider::cuboid(0.25, 0.25, 0.25).unwrap(),
+        Mass::new(2.0).unwrap(),
+        Transform::from_xyz(0.0, 0.25, 0.0),
+    ));
+    for _ in 0..30 {
+        app.update();
+    }
+    let normals = drawn(&app, PhysicsGizmos::default().contact_normals);
+    let shaft = normals.first().expect("a contact normal");
+    let length = (shaft[1] - shaft[0]).length();
+    let expected = 0.05 * 2.0 * 9.81;
+    assert!(
+        (length - expected).abs() < 0.02 * expected,
+        "arrow {length} m vs {expected} m"
+    );
+}

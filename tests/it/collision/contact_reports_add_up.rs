@@ -51,9 +51,9 @@ fn crate_on(world: &mut World, tilt: f32) -> Entity {
         .id()
 }
 
-/// A 2 kg box at rest on a slope of `tilt`, after 1 s: the step's reports, the impulse on
-/// the box, and dt.
-fn resting(tilt: f32, box_first: bool) -> (Vec<(ContactReport, f32)>, f32) {
+/// A 2 kg box at rest on a slope of `tilt`, after 1 s: the step's reports, dt, and the
+/// pair's impulse as `Contacts::pair` keeps it (its last substep's) with the substep count.
+fn resting(tilt: f32, box_first: bool) -> (Vec<(ContactReport, f32)>, f32, (f32, u32)) {
     let mut w = common::default_world();
     // Asleep, a body's contacts are not solved and not reported: keep it awake to watch the
     // load it keeps carrying.
@@ -72,16 +72,20 @@ fn resting(tilt: f32, box_first: bool) -> (Vec<(ContactReport, f32)>, f32) {
         reports_on(&w, &mut cursor, b);
     }
     w.step_physics();
-    (
-        reports_on(&w, &mut cursor, b),
-        w.resource::<PhysicsTime>().dt(),
-    )
+    let reports = reports_on(&w, &mut cursor, b);
+    let kept = reports.first().map_or(0.0, |(r, _)| {
+        w.resource::<Contacts>()
+            .pair(r.a, r.b)
+            .map_or(0.0, |p| p.normal_impulse)
+    });
+    let time = w.resource::<PhysicsTime>();
+    (reports, time.dt(), (kept, time.substeps()))
 }
 
 #[test]
 fn a_resting_box_reports_its_weight_at_its_four_corners() {
     for box_first in [true, false] {
-        let (reports, dt) = resting(0.0, box_first);
+        let (reports, dt, (last_substep, substeps)) = resting(0.0, box_first);
         assert_eq!(reports.len(), 1, "one pair, one report");
         let (r, sign) = &reports[0];
         let on_box = *sign * r.impulse;
@@ -101,6 +105,12 @@ fn a_resting_box_reports_its_weight_at_its_four_corners() {
             r.force()
         );
         assert_eq!(r.points.len(), 4, "the four corners");
+        // `Contacts::pair` keeps the last substep's impulse: at rest, a substep's share.
+        let share = weight / substeps as f32;
+        assert!(
+            (last_substep - share).abs() < 0.01 * share,
+            "last substep {last_substep} vs m g h {share}"
+        );
         for p in &r.points {
             assert!(p.position.y.abs() < 0.01, "on the ground: {}", p.position);
             assert!(
@@ -121,7 +131,7 @@ fn a_resting_box_reports_its_weight_at_its_four_corners() {
 fn a_box_held_by_friction_on_a_slope_reports_the_slope_share_as_friction() {
     let tilt = 20f32.to_radians();
     for box_first in [true, false] {
-        let (reports, dt) = resting(tilt, box_first);
+        let (reports, dt, _) = resting(tilt, box_first);
         assert_eq!(reports.len(), 1);
         let (r, sign) = &reports[0];
         let on_box = *sign * r.impulse;
