@@ -49,18 +49,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let apex = heights.iter().map(|h| h.1).fold(f32::MIN, f32::max);
     let rest = heights.last().map_or(f32::NAN, |h| h.1);
     // Before it reaches the belt's end (x = 7 m) and drops off onto the floor.
-    let carried = speeds
+    let (carried_at, carried) = speeds
         .iter()
         .take_while(|v| v.0 <= 1.5)
         .last()
-        .map_or(f32::NAN, |v| v.1);
+        .copied()
+        .unwrap_or((0.0, f32::NAN));
     println!(
-        "ball: apex {apex:.3} m (free flight {:.3}), rests at {rest:.3} m (platform top + r = {:.3})",
+        "ball: apex {apex:.3} m (free flight {:.3}), at {seconds} s its centre is at {rest:.3} m (resting on the platform: top + r = {:.3})",
         course.free_apex(g),
         course.platform_top + course.ball_radius
     );
     println!(
-        "crate: carried at {carried:.4} m/s at 1.5 s (belt {} m/s), μ = {mu}",
+        "crate: {carried:.4} m/s at {carried_at:.2} s (belt {} m/s), μ = {mu}",
         course.belt_speed
     );
 
