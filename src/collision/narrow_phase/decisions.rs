@@ -64,6 +64,8 @@ pub(crate) struct HookDecisions {
     pub(crate) stamp: Option<crate::collision::slots::Stamp>,
     /// Pairs with a hooked collider, and the hooks they run.
     pub(crate) hooked: Vec<((Entity, Entity), ActiveCollisionHooks)>,
+    /// The flagged colliders as read this step (kept to reuse its memory).
+    seen: Vec<(Entity, ActiveCollisionHooks)>,
     /// Pairs a filter hook turned away this step.
     pub rejected: HashSet<(Entity, Entity)>,
     /// Edits by pair slot, for this step.
@@ -94,9 +96,12 @@ impl HookDecisions {
         bp: &BroadPhase,
         flagged: &Query<(Entity, &ActiveCollisionHooks)>,
     ) {
-        let mut now: Vec<_> = flagged.iter().map(|(e, h)| (e, *h)).collect();
+        let mut now = std::mem::take(&mut self.seen);
+        now.clear();
+        now.extend(flagged.iter().map(|(e, h)| (e, *h)));
         now.sort_unstable_by_key(|f| f.0);
         if now == self.flagged && self.stamp == Some(bp.pairs_stamp()) {
+            self.seen = now;
             return;
         }
         let flags = |e: Entity| now.binary_search_by_key(&e, |f| f.0).ok().map(|i| now[i].1);
@@ -109,7 +114,7 @@ impl HookDecisions {
                 self.hooked.push(((a, b), h));
             }
         }
-        self.flagged = now;
+        self.seen = std::mem::replace(&mut self.flagged, now);
         self.stamp = Some(bp.pairs_stamp());
     }
 }
