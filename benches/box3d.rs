@@ -6,7 +6,12 @@
 //! cargo bench --bench box3d                                   # every scene, 4 runs each
 //! cargo bench --bench box3d -- --scene convex_pile --runs 1 --engine hooke   # to profile
 //! cargo bench --bench box3d -- --small                        # Box3D's debug sizes
+//! cargo bench --bench box3d -- --scene large_pyramid --planar  # every body in its xy-plane
 //! ```
+//!
+//! `--planar` locks every dynamic body to its xy-plane in both engines (hooke's
+//! `LockedAxes::XY_PLANE`, rapier's z translation and x, y rotations): the pyramids stand in
+//! that plane, so the scene is the same and what is timed is the locked path.
 
 #[path = "../examples/common/rapier_box3d.rs"]
 mod rapier_box3d;
@@ -25,6 +30,7 @@ fn main() {
     let runs: usize = arg("--runs").and_then(|s| s.parse().ok()).unwrap_or(4);
     let engine = arg("--engine").unwrap_or_else(|| "both".into());
     let only = arg("--scene");
+    let planar = std::env::args().any(|a| a == "--planar");
     println!("scene            engine  fastest ms/step  median ms/step");
     for scene in Scene::ALL {
         if only.as_deref().is_some_and(|o| o != scene.name()) {
@@ -34,11 +40,25 @@ fn main() {
         let (mut ours, mut theirs) = (Vec::new(), Vec::new());
         for _ in 0..runs {
             if engine != "rapier" {
-                let (mut w, _) = box3d::build(scene, small).unwrap();
+                let (mut w, bodies) = box3d::build(scene, small).unwrap();
+                if planar {
+                    for e in bodies {
+                        w.entity_mut(e).insert(LockedAxes::XY_PLANE);
+                    }
+                }
                 ours.push(1e3 * timing::mean_step_time(|| w.step_physics(), steps));
             }
             if engine != "hooke" {
-                let (mut r, _) = rapier_box3d::rapier_scene(scene, &scene.bodies(small));
+                let (mut r, handles) = rapier_box3d::rapier_scene(scene, &scene.bodies(small));
+                if planar {
+                    use rapier3d::prelude::LockedAxes as Locks;
+                    let locks = Locks::TRANSLATION_LOCKED_Z
+                        | Locks::ROTATION_LOCKED_X
+                        | Locks::ROTATION_LOCKED_Y;
+                    for h in handles {
+                        r.bodies[h].set_locked_axes(locks, false);
+                    }
+                }
                 theirs.push(1e3 * timing::mean_step_time(|| r.step(), steps));
             }
         }

@@ -254,6 +254,7 @@ pub mod prelude {
     pub use crate::rigid::CenterOfMass;
     pub use crate::rigid::Dominance;
     pub use crate::rigid::Inertia;
+    pub use crate::rigid::LockedAxes;
     pub use crate::rigid::MassProperties;
     pub use crate::rigid::MaxAngularSpeed;
     pub use crate::rigid::MaxLinearSpeed;

@@ -74,6 +74,7 @@ pub(super) fn register_types(app: &mut App) {
         crate::rigid::KinematicTarget,
         crate::rigid::MaxLinearSpeed,
         crate::rigid::Dominance,
+        crate::rigid::LockedAxes,
         crate::rigid::MaxAngularSpeed,
         crate::rigid::OrientationUpdate,
         crate::rigid::Renormalization,

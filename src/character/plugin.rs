@@ -125,6 +125,7 @@ type Pushed<'a> = (
     &'a mut LinearVelocity,
     Option<&'a mut AngularVelocity>,
     Option<&'a mut AngularMomentum>,
+    Option<&'a crate::rigid::LockedAxes>,
 );
 
 /// Rides, moves and slides each character, then gives what it walked into its push.
@@ -228,7 +229,7 @@ fn move_characters(
         }
 
         let translation = moved.position - origin;
-        if let Ok((.., mut v, w, _)) = bodies.p1().get_mut(entity) {
+        if let Ok((_, _, _, _, mut v, w, ..)) = bodies.p1().get_mut(entity) {
             v.0 = Vec3A::from(translation / dt);
             if let Some(mut w) = w.filter(|w| w.0 != Vec3A::ZERO) {
                 w.0 = Vec3A::ZERO;
@@ -253,13 +254,14 @@ fn push(
     contact: &slide::Contact,
     max_impulse: f32,
 ) -> Vec3 {
-    let Ok((x, q, mass, inertia, mut v, w, l)) = bodies.get_mut(contact.hit.entity) else {
+    let Ok((x, q, mass, inertia, mut v, w, l, locks)) = bodies.get_mut(contact.hit.entity) else {
         return Vec3::ZERO;
     };
-    let inverse_mass = mass.map_or(0.0, Mass::inverse);
-    if inverse_mass == 0.0 {
+    let inverse = mass.map_or(0.0, Mass::inverse);
+    if inverse == 0.0 {
         return Vec3::ZERO;
     }
+    let inverse_mass = Vec3::from(locks.map_or(Vec3A::splat(inverse), |l| l.inverse_mass(inverse)));
     let d = -contact.hit.normal;
     let wanted = contact.wanted.dot(d);
     if wanted <= 0.0 {
@@ -275,7 +277,11 @@ fn push(
     let inverse_tensor = inertia.map(|i| i.world_inverse_tensor(q.0));
     let turn = arm.cross(d);
     let angular = inverse_tensor.map_or(0.0, |t| turn.dot(t * turn));
-    let j = (shortfall / (inverse_mass + angular)).min(max_impulse);
+    let linear = d.dot(inverse_mass * d);
+    if linear + angular <= 0.0 {
+        return Vec3::ZERO;
+    }
+    let j = (shortfall / (linear + angular)).min(max_impulse);
     let impulse = d * j;
     v.0 += Vec3A::from(impulse * inverse_mass);
     if let (Some(inertia), Some(mut w), Some(mut l)) = (inertia, w, l) {

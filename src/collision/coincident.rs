@@ -7,7 +7,8 @@
 //! within 11 s). Boxes fared better only because a face normal is always defined. Each
 //! dynamic body spawned since the last step at the very position of an earlier one of that
 //! step (both with a collider) is moved [`APART`] metres along its own direction of a spiral over the sphere, so
-//! that the contacts push the heap apart in every direction, as jittered spawns do.
+//! that the contacts push the heap apart in every direction, as jittered spawns do (within
+//! the free axes of a body with [`crate::rigid::LockedAxes`]).
 
 use bevy_ecs::prelude::*;
 use glam::Vec3A;
@@ -39,14 +40,17 @@ fn spiral(k: u32) -> Vec3A {
 /// that cannot touch are left where they were put). Not while a snapshot restores.
 pub(crate) fn separate_coincident_spawns(
     event: On<Add<RigidBody>>,
-    mut bodies: Query<(&RigidBody, &mut Position), With<super::Collider>>,
+    mut bodies: Query<
+        (&RigidBody, &mut Position, Option<&crate::rigid::LockedAxes>),
+        With<super::Collider>,
+    >,
     recent: Option<ResMut<RecentSpawns>>,
     restoring: Option<Res<crate::core::restore::Restoring>>,
 ) {
     let Some(mut recent) = recent.filter(|_| restoring.is_none()) else {
         return;
     };
-    let Ok((kind, mut x)) = bodies.get_mut(event.event().entity) else {
+    let Ok((kind, mut x, locks)) = bodies.get_mut(event.event().entity) else {
         return;
     };
     if *kind != RigidBody::Dynamic || !x.0.is_finite() {
@@ -57,7 +61,12 @@ pub(crate) fn separate_coincident_spawns(
         .entry(x.0.to_array().map(f32::to_bits))
         .or_insert(0);
     if *count > 0 {
-        x.0 += spiral(*count) * APART;
+        // Never off a locked axis: a 2.5D game's bodies stay in their plane.
+        let away = match locks {
+            Some(l) => (spiral(*count) * l.translation_mask()).normalize_or_zero(),
+            None => spiral(*count),
+        };
+        x.0 += away * APART;
     }
     *count += 1;
 }

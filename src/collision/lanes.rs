@@ -42,6 +42,17 @@ impl V3 {
         self.x * o.x + self.y * o.y + self.z * o.z
     }
 
+    /// Component by component: (x₁x₂, y₁y₂, z₁z₂).
+    #[inline]
+    #[must_use]
+    pub fn scale(self, o: Self) -> Self {
+        Self {
+            x: self.x * o.x,
+            y: self.y * o.y,
+            z: self.z * o.z,
+        }
+    }
+
     #[inline]
     #[must_use]
     pub fn cross(self, o: Self) -> Self {

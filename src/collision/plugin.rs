@@ -56,7 +56,8 @@ impl WorldPlugin for CollisionPlugin {
             crate::core::schedule::SubstepSchedule,
             crate::collision::nodes::coupling::apply_node_impulses
                 .run_if(any_with_component::<crate::collision::nodes::coupling::NodeImpulse>)
-                .in_set(crate::core::schedule::StepSystems::AccumulateTorque),
+                .in_set(crate::core::schedule::StepSystems::AccumulateTorque)
+                .before(crate::rigid::hold_locked_translations),
         );
         world.add_observer(crate::collision::broad_phase::on_body_inserted);
         world.add_observer(crate::collision::broad_phase::on_body_removed);

@@ -182,7 +182,12 @@ pub(crate) fn constant_force(
 #[allow(clippy::type_complexity)] // two queries of plain component tuples
 pub(crate) fn apply_impulses(
     mut bodies: Query<
-        (&mut LinearVelocity, &mut ExternalImpulse, &Mass),
+        (
+            &mut LinearVelocity,
+            &mut ExternalImpulse,
+            &Mass,
+            Option<&crate::rigid::LockedAxes>,
+        ),
         (Changed<ExternalImpulse>, Simulated),
     >,
     mut at_points: Query<
@@ -195,6 +200,7 @@ pub(crate) fn apply_impulses(
             &Position,
             &Rotation,
             Option<&CenterOfMass>,
+            Option<&crate::rigid::LockedAxes>,
         ),
         (
             Changed<ExternalImpulseAtPoint>,
@@ -203,13 +209,13 @@ pub(crate) fn apply_impulses(
         ),
     >,
 ) {
-    for (mut v, mut j, m) in &mut bodies {
+    for (mut v, mut j, m, locks) in &mut bodies {
         if j.0 != Vec3::ZERO {
-            v.0 += Vec3A::from(j.0) * m.inverse();
+            v.0 += Vec3A::from(j.0) * inverse_mass(m, locks);
             j.bypass_change_detection().0 = Vec3::ZERO;
         }
     }
-    for (mut v, mut l, mut j, m, inertia, x, q, com) in &mut at_points {
+    for (mut v, mut l, mut j, m, inertia, x, q, com, locks) in &mut at_points {
         if j.impulse == Vec3::ZERO {
             continue;
         }
@@ -219,12 +225,18 @@ pub(crate) fn apply_impulses(
             j.point.into()
         };
         let impulse = Vec3A::from(j.impulse);
-        v.0 += impulse * m.inverse();
+        v.0 += impulse * inverse_mass(m, locks);
         if !inertia.is_infinite() {
             l.0 += (p - x.0).cross(impulse);
         }
         j.bypass_change_detection().impulse = Vec3::ZERO;
     }
+}
+
+/// The inverse mass per world axis: zero along a locked one.
+#[inline]
+fn inverse_mass(m: &Mass, locks: Option<&crate::rigid::LockedAxes>) -> Vec3A {
+    locks.map_or(Vec3A::splat(m.inverse()), |l| l.inverse_mass(m.inverse()))
 }
 
 /// The velocity half of a step; explicit Euler does its whole step here.

@@ -43,7 +43,7 @@ impl Measured {
             }
             if self.linear {
                 let rn = r.cross(self.n);
-                k += side.inv_m + rn.dot(side.inv_i * rn);
+                k += self.n.dot(side.inv_m * self.n) + rn.dot(side.inv_i * rn);
             } else {
                 k += self.n.dot(side.inv_i * self.n);
             }
@@ -293,6 +293,7 @@ fn friction(limit: f32, (a, b): (&mut Side, &mut Side), held: &mut Vec3A) {
             k += side.inv_i;
         }
     }
+    let k = super::solve::free_of_locks(k);
     let det = k.determinant();
     if !(det.is_finite() && det > 0.0) {
         return;

@@ -323,7 +323,7 @@ pub(super) mod tests {
     fn body(x: Vec3A) -> Side {
         Side {
             x,
-            inv_m: 1.0,
+            inv_m: Vec3A::ONE,
             inv_i: Mat3A::from_diagonal(Vec3::splat(6.0)),
             moves: true,
             ..Side::WORLD
@@ -386,7 +386,7 @@ pub(super) mod tests {
         let mut sides = vec![body(Vec3A::ZERO), body(Vec3A::new(0.9, 0.2, -0.1))];
         sides[0].v = Vec3A::new(0.0, 1.0, 0.0);
         sides[1].w = Vec3A::new(0.3, -2.0, 0.7);
-        sides[1].inv_m = 0.25;
+        sides[1].inv_m = Vec3A::splat(0.25);
         let mode = Mode {
             bias_rate: 20.0,
             mass_scale: 0.9,

@@ -319,7 +319,7 @@ mod tests {
         Side {
             x,
             q: Quat::from_rotation_y(0.3 * x.x),
-            inv_m,
+            inv_m: Vec3A::splat(inv_m),
             inv_i: Mat3A::from_diagonal(Vec3::new(6.0, 4.0, 9.0) * inv_m),
             w: spin,
             v: Vec3A::new(0.1 * x.y, -x.x, 0.5),

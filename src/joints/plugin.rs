@@ -103,6 +103,7 @@ type BodyItem<'a> = (
     Option<&'a mut AngularMomentum>,
     Option<&'a mut AngularVelocity>,
     Has<Sleeping>,
+    Option<&'a crate::rigid::LockedAxes>,
 );
 
 type Joints<'w, 's> = Query<'w, 's, JointItem<'static>, Without<Quarantined>>;
@@ -155,7 +156,8 @@ fn relax_joints(
 /// A body's side: immovable when it has no mass, is asleep or is not a body at all (the
 /// world), with its anchor measured from its centre of mass.
 fn load(bodies: &Bodies, e: Option<Entity>, anchor: Vec3) -> (Side, Vec3A) {
-    let Some((x, q, com, mass, inertia, v, l, w, asleep)) = e.and_then(|e| bodies.get(e).ok())
+    let Some((x, q, com, mass, inertia, v, l, w, asleep, locks)) =
+        e.and_then(|e| bodies.get(e).ok())
     else {
         return (Side::WORLD, Vec3A::from(anchor));
     };
@@ -170,7 +172,8 @@ fn load(bodies: &Bodies, e: Option<Entity>, anchor: Vec3) -> (Side, Vec3A) {
     }
     side.moves = mass.is_some_and(|m| m.inverse() > 0.0);
     side.v = v.map_or(Vec3A::ZERO, |v| v.0);
-    side.inv_m = mass.map_or(0.0, Mass::inverse);
+    let inverse = mass.map_or(0.0, Mass::inverse);
+    side.inv_m = locks.map_or(Vec3A::splat(inverse), |l| l.inverse_mass(inverse));
     match (inertia, l) {
         (Some(i), Some(l)) if !i.is_infinite() => {
             side.w = i.angular_velocity(q.0, l.0);
@@ -187,7 +190,7 @@ fn store(bodies: &mut Bodies, e: Option<Entity>, side: &Side) {
     if !side.moves {
         return;
     }
-    let Some((_, q, _, _, inertia, v, l, w, _)) = e.and_then(|e| bodies.get_mut(e).ok()) else {
+    let Some((_, q, _, _, inertia, v, l, w, ..)) = e.and_then(|e| bodies.get_mut(e).ok()) else {
         return;
     };
     if let Some(mut v) = v {

@@ -19,7 +19,9 @@ pub(super) struct Side {
     pub q: Quat,
     pub v: Vec3A,
     pub w: Vec3A,
-    pub inv_m: f32,
+    /// Inverse mass per world axis (zero along a locked one, see
+    /// [`crate::rigid::LockedAxes`]).
+    pub inv_m: Vec3A,
     pub inv_i: Mat3A,
     /// The angular impulse the pass gave it (N·m·s): L += this.
     pub dl: Vec3A,
@@ -37,7 +39,7 @@ impl Side {
         q: Quat::IDENTITY,
         v: Vec3A::ZERO,
         w: Vec3A::ZERO,
-        inv_m: 0.0,
+        inv_m: Vec3A::ZERO,
         inv_i: Mat3A::ZERO,
         dl: Vec3A::ZERO,
         moves: false,
@@ -302,9 +304,10 @@ pub(super) fn solve_ball(
                 Vec3A::new(-r.z, 0.0, r.x),
                 Vec3A::new(r.y, -r.x, 0.0),
             );
-            k += Mat3A::from_diagonal(Vec3::splat(side.inv_m)) - skew * side.inv_i * skew;
+            k += Mat3A::from_diagonal(side.inv_m.into()) - skew * side.inv_i * skew;
         }
     }
+    let k = free_of_locks(k);
     let det = k.determinant();
     if !(det.is_finite() && det > 0.0) {
         return;
@@ -363,6 +366,24 @@ fn outer(a: Vec3A, b: Vec3A) -> Mat3A {
 }
 
 /// The inverse of a symmetric positive definite 3 × 3, or None when it is not invertible.
+/// `k` with 1 on the diagonal of each row and column that is exactly zero: a world axis
+/// that [`crate::rigid::LockedAxes`] keeps both sides from moving along. Its λ then moves
+/// nothing, and the other axes are solved as if it were not there (otherwise the singular
+/// `k` would leave the whole joint unsolved).
+#[must_use]
+pub(super) fn free_of_locks(mut k: Mat3A) -> Mat3A {
+    if k == Mat3A::ZERO {
+        return k;
+    }
+    for i in 0..3 {
+        let row = Vec3A::new(k.x_axis[i], k.y_axis[i], k.z_axis[i]);
+        if row == Vec3A::ZERO && k.col(i) == Vec3A::ZERO {
+            k.col_mut(i)[i] = 1.0;
+        }
+    }
+    k
+}
+
 fn invert(m: Mat3A) -> Option<Mat3A> {
     let det = m.determinant();
     (det.is_finite() && det > 0.0).then(|| m.inverse())

@@ -42,12 +42,15 @@
 pub(crate) mod dominance;
 mod forces;
 mod limits;
+mod locked;
 mod mass;
 mod plugin;
 
 pub use dominance::Dominance;
 pub use forces::BodyForces;
 pub use limits::{MaxAngularSpeed, MaxLinearSpeed, speed_scale};
+pub use locked::LockedAxes;
+pub(crate) use locked::{free_mask as translation_mask, hold_locked_translations};
 pub(crate) use mass::{ComputedMass, insert_computed_mass};
 pub use mass::{MassProperties, RigidBodyBundle, default_mass, parallel_axis};
 pub use plugin::RigidBodyPlugin;
@@ -208,10 +211,15 @@ impl Validate for CenterOfMass {
 #[derive(serde::Serialize, serde::Deserialize, Component, Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "bevy", derive(bevy_reflect::Reflect), reflect(Component))]
 #[require(AngularMomentum, AngularVelocity, Torque, Rotation)]
+#[component(on_insert = locked::lock_inserted_inertia)]
 pub struct Inertia {
     principal: Vec3A,
     inverse: Vec3A,
     frame: Quat,
+    /// The world axes a [`LockedAxes`] holds the body from turning about (bits 0–2: x, y, z);
+    /// kept here so that every ω = I⁻¹ L sees them.
+    #[serde(default)]
+    locked: u8,
 }
 
 impl Inertia {
@@ -220,6 +228,7 @@ impl Inertia {
         principal: Vec3A::INFINITY,
         inverse: Vec3A::ZERO,
         frame: Quat::IDENTITY,
+        locked: 0,
     };
 
     /// Principal moments `principal` (kg·m²) about the axes of `frame` (body frame).
@@ -241,6 +250,7 @@ impl Inertia {
             principal: principal.into(),
             inverse: principal.recip().into(),
             frame,
+            locked: 0,
         })
     }
 
@@ -274,6 +284,9 @@ impl Inertia {
     /// The world inverse tensor I⁻¹ = R F diag(1/p) Fᵀ Rᵀ for orientation `q`.
     #[must_use]
     pub fn world_inverse_tensor(&self, q: Quat) -> glam::Mat3 {
+        if self.locked != 0 {
+            return self.world_tensors(q).1.into();
+        }
         let r = glam::Mat3::from_quat(unit(q) * self.frame);
         r * glam::Mat3::from_diagonal(self.inverse.into()) * r.transpose()
     }
@@ -284,6 +297,9 @@ impl Inertia {
     /// much, which disagreed with [`Self::angular_velocity`]'s exact L/I.
     #[must_use]
     pub fn world_tensors(&self, q: Quat) -> (glam::Mat3A, glam::Mat3A) {
+        if self.locked != 0 {
+            return self.locked_world_tensors(q);
+        }
         if self.is_isotropic() && !self.is_infinite() {
             return (
                 glam::Mat3A::from_diagonal(self.principal.into()),
@@ -319,6 +335,9 @@ impl Inertia {
     #[must_use]
     #[inline]
     pub fn angular_velocity(&self, q: Quat, l: Vec3A) -> Vec3A {
+        if self.locked != 0 {
+            return self.locked_angular_velocity(q, l);
+        }
         if self.is_isotropic() {
             return self.inverse.x * l;
         }
@@ -328,13 +347,20 @@ impl Inertia {
         qf * (self.inverse * (qf.inverse() * l))
     }
 
-    /// True when the three principal moments are equal (a sphere, a cube): then I is a
-    /// multiple of the identity in every frame.
+    /// True when the three principal moments are equal (a sphere, a cube) and no axis is
+    /// locked: then I⁻¹ is a multiple of the identity in every frame.
     #[must_use]
     #[inline]
     pub fn is_isotropic(&self) -> bool {
         let d = self.principal;
-        d.x == d.y && d.y == d.z
+        d.x == d.y && d.y == d.z && self.locked == 0
+    }
+
+    /// True when a [`LockedAxes`] holds the body from turning about some world axis.
+    #[must_use]
+    #[inline]
+    pub fn is_locked(&self) -> bool {
+        self.locked != 0
     }
 
     /// L = I ω with I = R I₀ Rᵀ, for orientation `q` (zero for infinite inertia, which keeps
@@ -563,6 +589,11 @@ pub fn integrate_rotation(q: Quat, omega: Vec3A, h: f32, update: OrientationUpda
 #[must_use]
 #[inline]
 pub fn free_rotation_split(q: Quat, inertia: &Inertia, l: Vec3A, h: f32, strang: bool) -> Quat {
+    if inertia.is_locked() {
+        // ω = (P I P)⁺ L (see `LockedAxes`): the free flow does not hold, and about a single
+        // free axis ω is constant between torques, which one turn follows exactly.
+        return turn_by(inertia.angular_velocity(q, l) * h) * unit(q);
+    }
     let inv = inertia.inverse;
     if inertia.is_isotropic() {
         // Equal moments (a sphere, a cube): ω = L/I is constant, and the exact flow is one

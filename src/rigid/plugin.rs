@@ -59,6 +59,10 @@ impl WorldPlugin for RigidBodyPlugin {
                 apply_forces_at_points
                     .run_if(any_with_component::<ExternalForceAtPoint>)
                     .in_set(StepSystems::AccumulateTorque),
+                super::locked::hold_locked_translations
+                    .run_if(any_with_component::<super::LockedAxes>)
+                    .in_set(StepSystems::AccumulateTorque)
+                    .after(apply_forces_at_points),
             )
         });
         add_own_systems(
@@ -93,6 +97,10 @@ fn sync_angular_inputs(mut bodies: Query<AngularInputs, WrittenByUser>) {
     for (q, inertia, mut w, mut l) in &mut bodies {
         let (w_changed, l_changed) = (w.is_changed(), l.is_changed());
         if w_changed && (!l_changed || w.0 != Vec3A::ZERO) {
+            if inertia.is_locked() {
+                // A spin written about a locked axis is dropped; the free ones are kept.
+                w.bypass_change_detection().0 = inertia.drop_locked_spin(w.0);
+            }
             l.bypass_change_detection().0 = inertia.angular_momentum(q.0, w.0);
         } else if l_changed && !inertia.is_infinite() {
             w.bypass_change_detection().0 = inertia.angular_velocity(q.0, l.0);

@@ -68,6 +68,7 @@ macro_rules! validated {
 }
 
 use crate::cloth::Cloth;
+use crate::collision::ActiveCollisionHooks;
 use crate::collision::Collider;
 use crate::collision::ColliderAabb;
 use crate::collision::ColliderDensity;
@@ -75,6 +76,7 @@ use crate::collision::ColliderOf;
 use crate::collision::ColliderOffset;
 use crate::collision::CollisionEventsEnabled;
 use crate::collision::CollisionLayers;
+use crate::collision::ContactReporting;
 use crate::collision::Friction;
 use crate::collision::Restitution;
 use crate::collision::RestitutionThreshold;
@@ -107,11 +109,15 @@ use crate::rigid::AngularMomentum;
 use crate::rigid::AngularVelocity;
 use crate::rigid::CenterOfMass;
 use crate::rigid::ComputedMass;
+use crate::rigid::Dominance;
 use crate::rigid::ExternalForceAtPoint;
 use crate::rigid::ExternalImpulseAtPoint;
 use crate::rigid::ExternalTorque;
 use crate::rigid::Inertia;
 use crate::rigid::KinematicTarget;
+use crate::rigid::LockedAxes;
+use crate::rigid::MaxAngularSpeed;
+use crate::rigid::MaxLinearSpeed;
 use crate::rigid::RigidBody;
 use crate::rigid::Rotation;
 use crate::rigid::SkipRenormalization;
@@ -145,6 +151,9 @@ validated!(
     KinematicTarget,
     CenterOfMass,
     JointBreakForce,
+    MaxLinearSpeed,
+    MaxAngularSpeed,
+    ContactReporting,
 );
 plain!(
     Force,
@@ -177,6 +186,9 @@ plain!(
     SkipRenormalization,
     RigidBody,
     JointImpulse,
+    LockedAxes,
+    Dominance,
+    ActiveCollisionHooks,
 );
 
 impl Column for Mass {
@@ -484,6 +496,12 @@ columns!(
     distance_joint: DistanceJoint,
     joint_impulse: JointImpulse,
     joint_break_force: JointBreakForce,
+    locked_axes: LockedAxes,
+    dominance: Dominance,
+    max_linear_speed: MaxLinearSpeed,
+    max_angular_speed: MaxAngularSpeed,
+    contact_reporting: ContactReporting,
+    active_collision_hooks: ActiveCollisionHooks,
     quarantined: Quarantined,
 );
 

@@ -175,6 +175,7 @@ type Body<'a> = (
     Option<&'a Mass>,
     Option<&'a Inertia>,
     Option<&'a CenterOfMass>,
+    Option<&'a crate::rigid::LockedAxes>,
 );
 
 /// Solves every attachment once per substep, after both sides have moved.
@@ -226,7 +227,11 @@ pub(crate) fn solve_attachments(
 fn solve_link(
     link: &mut Link,
     n: &mut Nodes,
-    (mut x, mut q, v, l, w, mass, inertia, com): bevy_ecs::query::QueryItem<'_, '_, Body<'_>>,
+    (mut x, mut q, v, l, w, mass, inertia, com, locks): bevy_ecs::query::QueryItem<
+        '_,
+        '_,
+        Body<'_>,
+    >,
     factor: Option<&SkylineCholesky>,
     h: f32,
 ) {
@@ -265,13 +270,17 @@ fn solve_link(
         x: Vec3::from(x.0),
         v: v.as_ref().map_or(Vec3::ZERO, |v| Vec3::from(v.0)),
         w: w.as_ref().map_or(Vec3::ZERO, |w| Vec3::from(w.0)),
-        inv_mass: mass.map_or(0.0, |m| m.inverse()),
+        inv_mass: {
+            let inverse = mass.map_or(0.0, |m| m.inverse());
+            locks.map_or(Vec3::splat(inverse), |l| l.inverse_mass(inverse).into())
+        },
         inv_inertia: inertia.map_or(Mat3::ZERO, |i| i.world_inverse_tensor(q.0)),
         dynamic: false,
         linear: Vec3::ZERO,
         angular: Vec3::ZERO,
     };
-    rigid.dynamic = v.is_some() && (rigid.inv_mass > 0.0 || rigid.inv_inertia != Mat3::ZERO);
+    rigid.dynamic =
+        v.is_some() && (rigid.inv_mass != Vec3::ZERO || rigid.inv_inertia != Mat3::ZERO);
     // The body feels each impulse at the node, not at its own point, so that the pair acts
     // at one place and turns nothing: the exchange keeps the angular momentum.
     let at: Vec<Vec3> = active.iter().map(|&k| Vec3::from(n.x[node(k)])).collect();

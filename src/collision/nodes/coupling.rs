@@ -101,7 +101,9 @@ pub(crate) struct RigidSide {
     pub x: Vec3,
     pub v: Vec3,
     pub w: Vec3,
-    pub inv_mass: f32,
+    /// Inverse mass per world axis (zero along a locked one, see
+    /// [`crate::rigid::LockedAxes`]).
+    pub inv_mass: Vec3,
     pub inv_inertia: Mat3,
     /// False for a static or kinematic body: it moves (or not) but takes no impulse.
     pub dynamic: bool,
@@ -124,7 +126,7 @@ impl RigidSide {
             return 0.0;
         }
         let rn = (p - self.x).cross(dir);
-        self.inv_mass + rn.dot(self.inv_inertia * rn)
+        dir.dot(self.inv_mass * dir) + rn.dot(self.inv_inertia * rn)
     }
 
     /// G_body for impulses along `rows` = (point, unit direction).
@@ -139,7 +141,7 @@ impl RigidSide {
             let rd = (p - self.x).cross(d);
             for (l, &(q, e)) in rows.iter().enumerate() {
                 let re = (q - self.x).cross(e);
-                g[(k, l)] = f64::from(self.inv_mass * d.dot(e) + rd.dot(self.inv_inertia * re));
+                g[(k, l)] = f64::from(d.dot(self.inv_mass * e) + rd.dot(self.inv_inertia * re));
             }
         }
         g
@@ -189,6 +191,7 @@ pub(crate) struct NodeImpulse {
 }
 
 type Pending<'a> = (
+    Option<&'a crate::rigid::LockedAxes>,
     &'a mut NodeImpulse,
     &'a mut LinearVelocity,
     &'a mut AngularMomentum,
@@ -200,12 +203,13 @@ type Pending<'a> = (
 
 /// Applies and clears [`NodeImpulse`]s: v += J/M, L += ΔL, ω = I⁻¹ L.
 pub(crate) fn apply_node_impulses(mut bodies: Query<Pending, Without<Quarantined>>) {
-    for (mut pending, mut v, mut l, mut w, m, i, q) in &mut bodies {
+    for (locks, mut pending, mut v, mut l, mut w, m, i, q) in &mut bodies {
         if *pending == NodeImpulse::default() {
             continue;
         }
         let p = std::mem::take(pending.bypass_change_detection());
-        v.0 += Vec3A::from(p.linear * m.inverse());
+        let inverse = locks.map_or(Vec3A::splat(m.inverse()), |l| l.inverse_mass(m.inverse()));
+        v.0 += Vec3A::from(p.linear) * inverse;
         let l = l.bypass_change_detection();
         l.0 += Vec3A::from(p.angular);
         w.bypass_change_detection().0 = i.angular_velocity(q.0, l.0);

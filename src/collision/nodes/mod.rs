@@ -78,6 +78,7 @@ type Dynamics<'a> = (
     &'a AngularVelocity,
     &'a Mass,
     &'a Inertia,
+    Option<&'a crate::rigid::LockedAxes>,
 );
 
 /// A mesh whose nodes collide: its contact layer's thickness, and where the contacts of the
@@ -99,17 +100,15 @@ type Mesh<'a, L> = (
     Option<&'a ImplicitEuler>,
 );
 
-fn side_of(
-    x: &Position,
-    q: &Rotation,
-    d: Option<(&LinearVelocity, &AngularVelocity, &Mass, &Inertia)>,
-) -> Option<RigidSide> {
-    let (v, w, m, i) = d?;
+fn side_of(x: &Position, q: &Rotation, d: Option<Dynamics<'_>>) -> Option<RigidSide> {
+    let (v, w, m, i, locks) = d?;
     Some(RigidSide {
         x: Vec3::from(x.0),
         v: Vec3::from(v.0),
         w: Vec3::from(w.0),
-        inv_mass: m.inverse(),
+        inv_mass: locks
+            .map_or(Vec3A::splat(m.inverse()), |l| l.inverse_mass(m.inverse()))
+            .into(),
         inv_inertia: i.world_inverse_tensor(q.0),
         dynamic: m.inverse() > 0.0 || !i.is_infinite(),
         linear: Vec3::ZERO,

@@ -113,6 +113,8 @@ impl ContactSolver {
             count,
             // Set below for a batch that bounces.
             tracked: Batch::UNTRACKED,
+            // Set with the axes.
+            locked: Batch::UNLOCKED,
             n: vector(|m| m.n),
             t: [vector(|m| m.t[0]), vector(|m| m.t[1])],
             // Set with the axes.

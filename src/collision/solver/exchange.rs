@@ -20,7 +20,7 @@ use bevy_ecs::prelude::*;
 use glam::{Mat3A, Vec3A};
 
 use crate::collision::ContactFilter;
-use crate::collision::solver::{BodyState, ContactSolver};
+use crate::collision::solver::{BodyState, ContactSolver, SolverBody};
 use crate::particles::{LinearVelocity, Position};
 use crate::rigid::{AngularMomentum, AngularVelocity, Rotation};
 
@@ -224,6 +224,11 @@ pub(crate) fn read_values(
     let mut turned = false;
     let w = match l {
         Some(&l) if b.dynamic && b.isotropic => b.inv_i.x_axis.x * l,
+        Some(&l) if b.dynamic && b.locked_inertia != SolverBody::UNLOCKED => {
+            let w;
+            (w, turned) = locked_omega(solver, i, q, l);
+            w
+        }
         Some(&l) if b.dynamic => {
             let dr = Mat3A::from_quat(dq);
             // Turned more than the axes allow since they were formed: the contact axes take
@@ -317,6 +322,26 @@ fn angular_impulse(b: &crate::collision::solver::SolverBody, state: &BodyState) 
     } else {
         b.i0 * dw
     }
+}
+
+/// ω = (P I P)⁺ L of solver body `i`, whose rotation is locked about some axis (see
+/// [`crate::rigid::LockedAxes`]), at rotation `q`; its contact axes take the inertia at `q`
+/// once it has turned past [`AXES_TURN`] (true then). The restricted inverse does not
+/// follow a turn as R I⁻¹ Rᵀ does (the locked axes stay put in the world), so it is formed
+/// again.
+#[inline(never)]
+fn locked_omega(solver: &mut ContactSolver, i: usize, q: glam::Quat, l: Vec3A) -> (Vec3A, bool) {
+    let b = &mut solver.bodies[i];
+    let Some(inertia) = solver.locked_inertias.get(b.locked_inertia as usize) else {
+        return (Vec3A::ZERO, false);
+    };
+    let mut turned = false;
+    if 1.0 - q.dot(b.q_axes).abs() > AXES_TURN && q.is_finite() {
+        (b.i0, b.inv_i) = inertia.world_tensors(q);
+        b.q_axes = q;
+        turned = true;
+    }
+    (inertia.angular_velocity(q, l), turned)
 }
 
 /// [`write()`] to plain values: v ← the solved v, L += I₀ Δω. Nothing for a body that is not

@@ -17,7 +17,8 @@
 
 use glam::Vec3A;
 
-use super::{Axis, Batch, F4, M3, ManifoldConstraint, Side, V3};
+use super::side::{LinearMass, Side};
+use super::{Axis, Batch, F4, M3, ManifoldConstraint, V3};
 
 /// The friction of four manifolds (one per lane).
 #[derive(Debug, Clone, Copy, Default)]
@@ -65,15 +66,39 @@ impl Friction {
 
     /// Effective masses from the sides' inverse masses and inertias; `live` is all-ones in
     /// lanes that hold a manifold.
-    pub fn compute(&mut self, batch: &Batch, (ma, ia): (F4, &M3), (mb, ib): (F4, &M3), live: F4) {
+    pub fn compute<M: LinearMass>(
+        &mut self,
+        batch: &Batch,
+        (ma, ia): (M, &M3),
+        (mb, ib): (M, &M3),
+        live: F4,
+    ) {
         let axis = |d: V3| Axis::new(ma, ia, self.r_a, mb, ib, self.r_b, d, live);
         self.tangent = [axis(batch.t[0]), axis(batch.t[1])];
         let rd = |t: V3| (self.r_a.cross(t), self.r_b.cross(t));
         let ((a0, b0), (a1, b1)) = (rd(batch.t[0]), rd(batch.t[1]));
         let [t0, t1] = &self.tangent;
-        let k00 = ma + mb + a0.dot(t0.ird_a) + b0.dot(t0.ird_b);
-        let k11 = ma + mb + a1.dot(t1.ird_a) + b1.dot(t1.ird_b);
-        let k01 = a0.dot(t1.ird_a) + b0.dot(t1.ird_b);
+        let [d0, d1] = batch.t;
+        let k00 = ma.along(d0) + mb.along(d0) + a0.dot(t0.ird_a) + b0.dot(t0.ird_b);
+        let k11 = ma.along(d1) + mb.along(d1) + a1.dot(t1.ird_a) + b1.dot(t1.ird_b);
+        // The tangents are orthogonal: their linear terms couple only through a locked axis.
+        let k01 = a0.dot(t1.ird_a) + b0.dot(t1.ird_b) + (ma.across(d0, d1) + mb.across(d0, d1));
+        let (k00, k11, k01) = if M::LOCKS {
+            // A tangent that locks keep both sides from moving along, or nearly (a planar
+            // body sliding in its plane: the other tangent is the locked axis), is vacuous
+            // (see `VACUOUS`): solved with a unit mass and uncoupled, it takes an impulse
+            // that moves nothing, and the other tangent is solved alone. (A singular K left
+            // the manifold without friction; a nearly singular one overflowed.)
+            let floor = F4::splat(super::VACUOUS) * (ma.largest() + mb.largest());
+            let (vacuous_0, vacuous_1) = (k00.simd_le(floor), k11.simd_le(floor));
+            (
+                vacuous_0.select(F4::ONE, k00),
+                vacuous_1.select(F4::ONE, k11),
+                (vacuous_0 | vacuous_1).select(F4::ZERO, k01),
+            )
+        } else {
+            (k00, k11, k01)
+        };
         let det = k00 * k11 - k01 * k01;
         let usable = det.simd_gt(F4::ZERO) & live;
         let inv = |x: F4| usable.select(x / det, F4::ZERO);
@@ -89,14 +114,20 @@ impl Friction {
     }
 
     /// Applies the accumulated impulses once.
-    pub fn warm_start(&self, batch: &Batch, a: &mut Side, b: &mut Side) {
+    pub fn warm_start<M: LinearMass>(&self, batch: &Batch, a: &mut Side<M>, b: &mut Side<M>) {
         Side::push(a, b, batch.t[0], &self.tangent[0], self.imp[0]);
         Side::push(a, b, batch.t[1], &self.tangent[1], self.imp[1]);
         Self::turn(a, b, &self.twist, self.twist_imp);
     }
 
     /// One friction pass; `normal` is each lane's total normal impulse.
-    pub fn solve(&mut self, batch: &Batch, normal: F4, a: &mut Side, b: &mut Side) {
+    pub fn solve<M: LinearMass>(
+        &mut self,
+        batch: &Batch,
+        normal: F4,
+        a: &mut Side<M>,
+        b: &mut Side<M>,
+    ) {
         let limit = batch.friction * normal;
         let rel = Side::relative(a, b, self.r_a, self.r_b);
         let dv = [
@@ -129,7 +160,7 @@ impl Friction {
 
     /// A pure angular impulse τ about n: −τ to a, +τ to b.
     #[inline]
-    fn turn(a: &mut Side, b: &mut Side, twist: &Axis, tau: F4) {
+    fn turn<M>(a: &mut Side<M>, b: &mut Side<M>, twist: &Axis, tau: F4) {
         a.w -= tau * twist.ird_a;
         b.w += tau * twist.ird_b;
     }

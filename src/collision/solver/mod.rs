@@ -25,8 +25,10 @@
 
 mod colour;
 pub(crate) mod exchange;
+mod passes;
 pub(crate) mod plugin;
 pub(crate) mod prepare;
+mod side;
 mod turning;
 pub(crate) mod whole_step;
 
@@ -34,9 +36,15 @@ use bevy_ecs::prelude::*;
 use glam::{Mat3A, Quat, Vec3A};
 
 use crate::collision::lanes::{F4, M3, Q4, V3};
+use side::LinearMass;
 
 /// Index of the immovable "body" that stands for every static collider.
 pub(crate) const FIXED: u32 = u32::MAX;
+
+/// The share of an unlocked body's response below which a contact direction counts as
+/// vacuous for bodies with [`crate::rigid::LockedAxes`] (see [`Axis::new`]): a normal
+/// within about 6° of a locked axis.
+const VACUOUS: f32 = 0.01;
 
 /// Colours tried before a manifold goes to the one-per-batch overflow.
 const COLOURS: usize = 12;
@@ -47,6 +55,13 @@ pub(crate) struct SolverBody {
     pub entity: Entity,
     /// Zero for kinematic bodies: they drive contacts but are never pushed.
     pub inv_mass: f32,
+    /// The world axes its translation is locked along (bits 0–2, see
+    /// [`crate::rigid::LockedAxes`]): zero inverse mass along them.
+    pub translation_locks: u8,
+    /// Its [`crate::rigid::Inertia`] in [`ContactSolver::locked_inertias`] when a rotation is
+    /// locked ([`Self::UNLOCKED`] otherwise): ω = (P I P)⁺ L is formed from it again as it
+    /// turns.
+    pub locked_inertia: u32,
     /// World inverse inertia the contact axes were last formed with (zero for kinematic
     /// bodies): at the start of the step, then at the rotation `q_axes`.
     pub inv_i: Mat3A,
@@ -79,6 +94,17 @@ pub(crate) struct SolverBody {
     pub speed_in: f32,
 }
 
+impl SolverBody {
+    /// [`Self::locked_inertia`] of a body with no locked rotation.
+    pub const UNLOCKED: u32 = u32::MAX;
+
+    /// Its inverse mass per world axis.
+    #[must_use]
+    pub fn inverse_mass(&self) -> Vec3A {
+        crate::rigid::translation_mask(self.translation_locks) * self.inv_mass
+    }
+}
+
 #[cfg(test)]
 impl SolverBody {
     /// A dynamic body at the origin, unturned, for tests.
@@ -86,6 +112,8 @@ impl SolverBody {
         Self {
             entity,
             inv_mass,
+            translation_locks: 0,
+            locked_inertia: Self::UNLOCKED,
             inv_i,
             i0: inv_i,
             inv_i_start: inv_i,
@@ -191,11 +219,20 @@ impl Axis {
     /// `live` is all-ones for lanes that hold a point, zero for padding (mass 0: no impulse).
     #[inline]
     #[allow(clippy::too_many_arguments)] // the two sides of one formula
-    fn new(ma: F4, ia: &M3, ra: V3, mb: F4, ib: &M3, rb: V3, d: V3, live: F4) -> Self {
+    fn new<M: LinearMass>(ma: M, ia: &M3, ra: V3, mb: M, ib: &M3, rb: V3, d: V3, live: F4) -> Self {
         let (rd_a, rd_b) = (ra.cross(d), rb.cross(d));
         let (ird_a, ird_b) = (ia.mul_vec(rd_a), ib.mul_vec(rd_b));
-        let k = ma + mb + rd_a.dot(ird_a) + rd_b.dot(ird_b);
-        let usable = k.simd_gt(F4::ZERO) & live;
+        let k = ma.along(d) + mb.along(d) + rd_a.dot(ird_a) + rd_b.dot(ird_b);
+        let floor = if M::LOCKS {
+            // A direction within a few degrees of one that locks hold both sides along: an
+            // impulse could move it only sideways, by the inverse of that small share (two
+            // bodies locked in neighbouring planes that overlap in depth were flung at
+            // thousands of m/s). It is left unsolved, as an exactly locked one is.
+            F4::splat(VACUOUS) * (ma.largest() + mb.largest())
+        } else {
+            F4::ZERO
+        };
+        let usable = k.simd_gt(floor) & live;
         Self {
             ird_a,
             ird_b,
@@ -271,6 +308,10 @@ struct Batch {
     /// Its points' restitution records start at this index of [`ContactSolver::tracks`];
     /// [`Batch::UNTRACKED`] for a batch that does not bounce, which keeps none.
     tracked: u32,
+    /// Its sides' per-axis inverse masses are at this index of
+    /// [`ContactSolver::lock_masses`] when some lane's body has a locked translation;
+    /// [`Batch::UNLOCKED`] otherwise (the scalar `inv_m_a`, `inv_m_b` then hold).
+    locked: u32,
     n: V3,
     t: [V3; 2],
     inv_m_a: F4,
@@ -289,6 +330,9 @@ struct Batch {
 impl Batch {
     /// [`Batch::tracked`] of a batch without restitution records.
     const UNTRACKED: u32 = u32::MAX;
+
+    /// [`Batch::locked`] of a batch whose bodies lock no translation.
+    const UNLOCKED: u32 = u32::MAX;
 
     /// Where its points' restitution records are in [`ContactSolver::tracks`] (empty for a
     /// batch that does not bounce).
@@ -327,6 +371,13 @@ pub(crate) struct ContactSolver {
     tracks: Vec<Track>,
     /// Per batch: its manifolds' friction.
     friction: Vec<friction::Friction>,
+    /// Per batch with a locked translation (see [`Batch::locked`]), its sides' inverse
+    /// masses per axis.
+    lock_masses: Vec<[V3; 2]>,
+    /// The inertias of the bodies with a locked rotation (see [`SolverBody::locked_inertia`]).
+    pub locked_inertias: Vec<crate::rigid::Inertia>,
+    /// Some body of the step has a locked translation.
+    pub translation_locks: bool,
     /// Some body overlaps something deeply this step (see [`Self::solve_grounded`]).
     any_deep: bool,
     /// Passes visit only the batches with a static or kinematic side.
@@ -417,93 +468,6 @@ fn impact_speed(vn: F4, s: F4, seen: [F4; 2], inv_h: F4) -> F4 {
     extrapolate.select(-(vn * vn - (a + a) * s).sqrt(), vn)
 }
 
-/// One side of four manifolds during a pass.
-#[derive(Clone, Copy)]
-struct Side {
-    v: V3,
-    w: V3,
-    inv_m: F4,
-}
-
-impl Side {
-    /// Velocity of b's material point against a's at the contact points (lever arms `r_a`,
-    /// `r_b`). Its component along a direction d equals d·(v_b − v_a) + ω_b·(r_b × d) −
-    /// ω_a·(r_a × d), so the lever products need not be stored.
-    #[inline]
-    fn relative(a: &Side, b: &Side, r_a: V3, r_b: V3) -> V3 {
-        (b.v + b.w.cross(r_b)) - (a.v + a.w.cross(r_a))
-    }
-
-    /// Applies impulse λ along `d`: −λ to a, +λ to b.
-    #[inline]
-    fn push(a: &mut Side, b: &mut Side, d: V3, axis: &Axis, lambda: F4) {
-        a.v -= (a.inv_m * lambda) * d;
-        a.w -= lambda * axis.ird_a;
-        b.v += (b.inv_m * lambda) * d;
-        b.w += lambda * axis.ird_b;
-    }
-}
-
-/// What a pass knows of one batch before it visits its points.
-struct Pass {
-    n: V3,
-    /// n·(Δx_b − Δx_a), and ΔRᵀn of each side: the separation's change is then two dot
-    /// products per point (n·(ΔR r) = (ΔRᵀn)·r).
-    shift: F4,
-    turn_a: V3,
-    turn_b: V3,
-    inv_h: F4,
-    bias_rate: F4,
-    mass_scale: F4,
-    impulse_scale: F4,
-    /// Minus the push-out speed limit (m/s).
-    max_push: F4,
-}
-
-impl Pass {
-    /// One point's normal impulse (see [`ContactSolver::solve`]); `TRACK` keeps the record
-    /// the restitution reads in `t`.
-    #[inline(always)]
-    fn point<const BIAS: bool, const TRACK: bool>(
-        &self,
-        p: &mut Point,
-        t: &mut Track,
-        a: &mut Side,
-        b: &mut Side,
-    ) {
-        let zero = F4::ZERO;
-        let s = (self.shift + (self.turn_b.dot(p.r_b) - self.turn_a.dot(p.r_a))) + p.base;
-        let speculative = s.simd_gt(zero);
-        let bias = speculative.select(s * self.inv_h, (self.bias_rate * s).fast_max(self.max_push));
-        let m_scale = speculative.select(F4::ONE, self.mass_scale);
-        let i_scale = speculative.select(zero, self.impulse_scale);
-        let vn = self.n.dot(Side::relative(a, b, p.r_a, p.r_b));
-        if BIAS && TRACK {
-            t.vn_seen = [t.vn_seen[1], vn];
-        }
-        let imp = -p.normal.mass * m_scale * (vn + bias) - i_scale * p.n_imp;
-        let total = (p.n_imp + imp).fast_max(zero);
-        let imp = total - p.n_imp;
-        if TRACK {
-            let first = t.max_n.simd_eq(zero) & imp.simd_gt(zero);
-            if first.any() {
-                let hit = impact_speed(vn, s, t.vn_seen, self.inv_h);
-                t.approach = first.select(t.approach.fast_min(hit), t.approach);
-                t.gain = first.select(hit * hit - vn * vn, t.gain);
-            }
-            t.max_n = t.max_n.fast_max(imp);
-            t.lost -= work(imp, vn, t.half_w);
-            if !BIAS {
-                // The relax pass is each substep's last: n_imp is that substep's impulse.
-                t.vn_end = vn + F4::splat(2.0) * imp * t.half_w;
-                t.absorbed += total;
-            }
-        }
-        p.n_imp = total;
-        Side::push(a, b, self.n, &p.normal, imp);
-    }
-}
-
 impl ContactSolver {
     /// Empties the solver for a new step.
     pub fn clear(&mut self) {
@@ -517,6 +481,9 @@ impl ContactSolver {
         self.points.clear();
         self.tracks.clear();
         self.friction.clear();
+        self.lock_masses.clear();
+        self.locked_inertias.clear();
+        self.translation_locks = false;
         self.turned.clear();
         self.totals.clear();
         self.edited = false;
@@ -551,7 +518,35 @@ impl ContactSolver {
                 (keep(batch.a, 1), keep(batch.b, 2))
             }
         };
-        let (ma, mb, ia, ib) = (inv_m(a), inv_m(b), inv_i(a), inv_i(b));
+        let (ia, ib) = (inv_i(a), inv_i(b));
+        let locked = self.translation_locks
+            && (a.iter().chain(&b)).any(|&i| body(i).is_some_and(|b| b.translation_locks != 0));
+        if locked {
+            let inv_m = |ix: [u32; 4]| {
+                V3::from_lanes(ix.map(|i| body(i).map_or(Vec3A::ZERO, SolverBody::inverse_mass)))
+            };
+            let masses = [inv_m(a), inv_m(b)];
+            self.fill_axes(bi, (masses[0], &ia), (masses[1], &ib));
+            let batch = &mut self.batches[bi];
+            match batch.locked {
+                Batch::UNLOCKED => {
+                    batch.locked = self.lock_masses.len() as u32;
+                    self.lock_masses.push(masses);
+                }
+                i => self.lock_masses[i as usize] = masses,
+            }
+        } else {
+            let (ma, mb) = (inv_m(a), inv_m(b));
+            self.fill_axes(bi, (ma, &ia), (mb, &ib));
+            let batch = &mut self.batches[bi];
+            (batch.inv_m_a, batch.inv_m_b) = (ma, mb);
+            batch.locked = Batch::UNLOCKED;
+        }
+    }
+
+    /// [`Self::compute_axes`] from the sides' inverse masses and inertias.
+    fn fill_axes<M: LinearMass>(&mut self, bi: usize, (ma, ia): (M, &M3), (mb, ib): (M, &M3)) {
+        let batch = self.batches[bi];
         let counts = batch
             .lanes
             .map(|mi| self.manifolds.get(mi as usize).map_or(0, |m| m.count));
@@ -566,7 +561,7 @@ impl ContactSolver {
                     0.0
                 }
             }));
-            p.normal = Axis::new(ma, &ia, p.r_a, mb, &ib, p.r_b, batch.n, live);
+            p.normal = Axis::new(ma, ia, p.r_a, mb, ib, p.r_b, batch.n, live);
             if let Some(t) = tracks.get_mut(k) {
                 t.half_w = p
                     .normal
@@ -576,9 +571,7 @@ impl ContactSolver {
             }
         }
         let lanes = F4::new(counts.map(|c| if c > 0 { f32::from_bits(!0) } else { 0.0 }));
-        self.friction[bi].compute(&batch, (ma, &ia), (mb, &ib), lanes);
-        let batch = &mut self.batches[bi];
-        (batch.inv_m_a, batch.inv_m_b) = (ma, mb);
+        self.friction[bi].compute(&batch, (ma, ia), (mb, ib), lanes);
     }
 
     /// Takes `body` out of the rest of the step: it turned non-finite, and from now on every
@@ -601,206 +594,6 @@ impl ContactSolver {
                 self.compute_axes(bi);
             }
         }
-    }
-
-    #[inline]
-    fn load(states: &[BodyState], ix: [u32; 4], inv_m: F4) -> Side {
-        let s = ix.map(|i| &states[i as usize]);
-        Side {
-            v: V3::from_lanes(s.map(|s| s.v)),
-            w: V3::from_lanes(s.map(|s| s.w)),
-            inv_m,
-        }
-    }
-
-    /// Writes a side back. Lanes of static sides and empty lanes write into the rest state:
-    /// call [`Self::settle_rest`] after the batch's stores (a store per lane and one reset
-    /// is cheaper than a branch per lane).
-    #[inline]
-    fn store(states: &mut [BodyState], ix: [u32; 4], side: &Side) {
-        let (v, w) = (side.v.lanes(), side.w.lanes());
-        for l in 0..4 {
-            if let Some(s) = states.get_mut(ix[l] as usize) {
-                s.v = v[l];
-                s.w = w[l];
-            }
-        }
-    }
-
-    /// Puts the rest state (`rest`) back at rest after a batch's stores.
-    #[inline]
-    fn settle_rest(states: &mut [BodyState], rest: u32) {
-        if let Some(s) = states.get_mut(rest as usize) {
-            s.v = Vec3A::ZERO;
-            s.w = Vec3A::ZERO;
-        }
-    }
-
-    /// Δx and ΔR of both sides, for the current separations.
-    #[inline]
-    fn motion(states: &[BodyState], ix: [u32; 4]) -> (V3, Q4) {
-        let s = ix.map(|i| &states[i as usize]);
-        (
-            V3::from_lanes(s.map(|s| s.dx)),
-            Q4::from_lanes(s.map(|s| s.dq)),
-        )
-    }
-
-    /// Runs `f` on every batch with both sides loaded, then stores the sides back. Borrows
-    /// field by field: a batch is a few hundred bytes, and copying it out of `self` for
-    /// each pass cost a memcpy call per batch.
-    #[inline(always)]
-    fn for_each_batch(
-        &mut self,
-        mut f: impl FnMut(
-            &Batch,
-            &mut friction::Friction,
-            (&mut [Point], &mut [Track]),
-            &[BodyState],
-            &mut [Side; 2],
-        ),
-    ) {
-        let rest = self.rest();
-        let Self {
-            batches,
-            points,
-            tracks,
-            states,
-            friction,
-            grounded_only,
-            ..
-        } = self;
-        for (batch, friction) in batches.iter().zip(friction.iter_mut()) {
-            if *grounded_only && !batch.fixed.any() {
-                continue;
-            }
-            let mut sides = [
-                Self::load(states, batch.a, batch.inv_m_a),
-                Self::load(states, batch.b, batch.inv_m_b),
-            ];
-            let range = batch.first as usize..(batch.first + batch.count) as usize;
-            let points = (&mut points[range], &mut tracks[batch.tracks()]);
-            f(batch, friction, points, states, &mut sides);
-            Self::store(states, batch.a, &sides[0]);
-            Self::store(states, batch.b, &sides[1]);
-            Self::settle_rest(states, rest);
-        }
-    }
-
-    /// Applies every accumulated impulse once (warm start).
-    pub fn warm_start(&mut self) {
-        self.for_each_batch(|batch, friction, (points, tracks), _, [a, b]| {
-            if batch.bouncy() {
-                // The work at the present relative velocity, point by point as the impulses
-                // land: the velocity the last pass left is stale by every impulse other
-                // contacts gave the two bodies after it (in a row of touching balls, most of
-                // the row's), and a budget credited from it let restitution create energy
-                // in some spawn orders.
-                for (p, t) in points.iter().zip(tracks.iter_mut()) {
-                    let vn = batch.n.dot(Side::relative(a, b, p.r_a, p.r_b));
-                    t.lost -= work(p.n_imp, vn, t.half_w);
-                    Side::push(a, b, batch.n, &p.normal, p.n_imp);
-                }
-            } else {
-                for p in points.iter() {
-                    Side::push(a, b, batch.n, &p.normal, p.n_imp);
-                }
-            }
-            friction.warm_start(batch, a, b);
-        });
-    }
-
-    /// One pass over every contact: normal impulses, with the soft bias when `use_bias`;
-    /// friction (one per manifold, see the `friction` module) only in the relax pass
-    /// (without bias), after the normals, so that its limit is the full normal impulse and it
-    /// never reacts to push-out velocities. The warm start carries last pass's friction into
-    /// the biased pass, which keeps resting bodies from creeping (measured: 0.25 mm in 2 s on
-    /// a 30° slope at μ = 0.6). Friction in the biased
-    /// pass as well (rapier also leaves it out) cost a fifth of the pass and left a heavy box
-    /// on a light one jittering at 8 mm/s instead of 1 mm/s.
-    ///
-    /// The relax pass takes each manifold's points in reverse order (a symmetric
-    /// Gauss–Seidel sweep): in one order every pass, the first corners solved took more of a
-    /// landing's impulse, and a cube dropped flat walked 1.5 mm sideways (0.4 mm now).
-    pub fn solve(
-        &mut self,
-        h: f32,
-        soft: Softness,
-        fixed_soft: Softness,
-        use_bias: bool,
-        max_push: f32,
-    ) {
-        // One copy of the pass per kind, so that neither tests the kind per point.
-        if use_bias {
-            self.solve_pass::<true>(h, soft, fixed_soft, max_push);
-        } else {
-            self.solve_pass::<false>(h, soft, fixed_soft, max_push);
-        }
-    }
-
-    fn solve_pass<const BIAS: bool>(
-        &mut self,
-        h: f32,
-        soft: Softness,
-        fixed_soft: Softness,
-        max_push: f32,
-    ) {
-        let inv_h = F4::splat(1.0 / h);
-        let max_push = F4::splat(-max_push);
-        let (zero, one) = (F4::ZERO, F4::ONE);
-        self.for_each_batch(|batch, friction, (points, tracks), states, [a, b]| {
-            let (dx_a, dq_a) = Self::motion(states, batch.a);
-            let (dx_b, dq_b) = Self::motion(states, batch.b);
-            let pick = |f: fn(&Softness) -> f32| {
-                batch
-                    .fixed
-                    .select(F4::splat(f(&fixed_soft)), F4::splat(f(&soft)))
-            };
-            let (bias_rate, mass_scale, impulse_scale) = if BIAS {
-                (
-                    pick(|s| s.bias_rate),
-                    pick(|s| s.mass_scale),
-                    pick(|s| s.impulse_scale),
-                )
-            } else {
-                (zero, one, zero)
-            };
-            // n·(ΔR r) = (ΔRᵀ n)·r: one quaternion turn per side per batch, not per point.
-            let (turn_a, turn_b) = (dq_a.inverse_rotate(batch.n), dq_b.inverse_rotate(batch.n));
-            let pass = Pass {
-                n: batch.n,
-                shift: batch.n.dot(dx_b - dx_a),
-                turn_a,
-                turn_b,
-                inv_h,
-                bias_rate,
-                mass_scale,
-                impulse_scale,
-                max_push,
-            };
-            if batch.bouncy() {
-                let mut visit = |(p, t): (&mut Point, &mut Track)| {
-                    pass.point::<BIAS, true>(p, t, a, b);
-                };
-                let pairs = points.iter_mut().zip(tracks.iter_mut());
-                match BIAS {
-                    true => pairs.for_each(&mut visit),
-                    false => pairs.rev().for_each(&mut visit),
-                }
-            } else {
-                // A batch that does not bounce keeps no record: this one is not read.
-                let mut unread = Track::default();
-                let mut visit = |p: &mut Point| pass.point::<BIAS, false>(p, &mut unread, a, b);
-                match BIAS {
-                    true => points.iter_mut().for_each(&mut visit),
-                    false => points.iter_mut().rev().for_each(&mut visit),
-                }
-            }
-            if !BIAS {
-                let normal = points.iter().fold(F4::ZERO, |s, p| s + p.n_imp);
-                friction.solve(batch, normal, a, b);
-            }
-        });
     }
 }
 

@@ -38,6 +38,16 @@ type PreparedBody<'a> = (
     Has<Sleeping>,
 );
 
+/// What only some bodies have, looked up apart (see `prepare_contacts`).
+type Extras<'a> = (
+    Option<&'a crate::rigid::Dominance>,
+    Option<&'a crate::rigid::LockedAxes>,
+);
+type ExtrasFilter = Or<(
+    With<crate::rigid::Dominance>,
+    With<crate::rigid::LockedAxes>,
+)>;
+
 /// One side of the step's contacts as constraint building needs it, fetched once per step
 /// however many pairs its body is in.
 pub(crate) struct Side {
@@ -70,6 +80,8 @@ pub(crate) struct Side {
     bad_material: Option<crate::core::error::Error>,
     /// Its [`crate::rigid::Dominance`] group.
     dominance: i8,
+    /// Its [`crate::rigid::LockedAxes`]' translation bits.
+    translation_locks: u8,
 }
 
 impl Side {
@@ -130,6 +142,7 @@ impl Side {
             inertia: inertia.copied(),
             bad_material,
             dominance: 0,
+            translation_locks: 0,
         }
     }
 }
@@ -214,10 +227,21 @@ fn new_body(solver: &mut ContactSolver, side: &Side) -> u32 {
         }
         _ => (Mat3A::ZERO, Mat3A::ZERO),
     };
+    // A locked rotation: ω = (P I P)⁺ L is formed from the inertia again as the body turns.
+    let locked_inertia = match side.inertia {
+        Some(i) if dynamic && i.is_locked() => {
+            solver.locked_inertias.push(i);
+            solver.locked_inertias.len() as u32 - 1
+        }
+        _ => SolverBody::UNLOCKED,
+    };
+    solver.translation_locks |= side.translation_locks != 0;
     let i = solver.bodies.len() as u32;
     solver.bodies.push(SolverBody {
         entity: side.entity,
         inv_mass: if dynamic { mass.inverse() } else { 0.0 },
+        translation_locks: side.translation_locks,
+        locked_inertia,
         inv_i,
         i0,
         inv_i_start: inv_i,
@@ -280,7 +304,7 @@ pub(crate) fn prepare_contacts(
     mut commands: Commands,
     hooks: Option<Res<crate::collision::narrow_phase::decisions::HookDecisions>>,
     reporting: Query<(), With<crate::collision::ContactReporting>>,
-    dominance: Query<&crate::rigid::Dominance>,
+    extras: Query<Extras, ExtrasFilter>,
 ) {
     let s = &mut *solver;
     s.clear();
@@ -303,11 +327,14 @@ pub(crate) fn prepare_contacts(
     sides.clear();
     sides.resize_with(wanted.len(), || None);
     wanted.fetch(&bodies, |b| b.0, |i, b| sides[i] = Some(Side::new(b)));
-    // Looked up apart, and only in a world that has groups: a column more in the fetch
-    // above cost every contact scene 2–3 % of its preparation.
-    if !dominance.is_empty() {
+    // Looked up apart, and only in a world that has groups or locks: a column more in the
+    // fetch above cost every contact scene 2–3 % of its preparation.
+    if !extras.is_empty() {
         for side in sides.iter_mut().flatten() {
-            side.dominance = dominance.get(side.entity).map_or(0, |d| d.0);
+            if let Ok((dominance, locks)) = extras.get(side.entity) {
+                side.dominance = dominance.map_or(0, |d| d.0);
+                side.translation_locks = locks.map_or(0, |l| l.translation_bits());
+            }
         }
     }
     for side in sides.iter().flatten() {

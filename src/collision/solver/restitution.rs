@@ -1,6 +1,7 @@
 //! Restitution after the last substep (see [`ContactSolver::restitution`]).
 
-use super::{ContactSolver, F4, Side, work};
+use super::side::{LinearMass, Side};
+use super::{Batch, ContactSolver, F4, Point, Track, work};
 
 impl ContactSolver {
     /// After the last substep: contacts that hit faster than their threshold leave at −e times
@@ -21,6 +22,7 @@ impl ContactSolver {
             points,
             tracks,
             states,
+            lock_masses,
             ..
         } = self;
         // The budget: e² of the energy lost, and of what the impact-speed extrapolation adds
@@ -41,40 +43,64 @@ impl ContactSolver {
             }
         }
         for batch in batches.iter().filter(|b| b.bouncy()) {
-            let bouncy = batch.restitution.simd_gt(zero);
-            let (mut a, mut b) = (
-                Self::load(states, batch.a, batch.inv_m_a),
-                Self::load(states, batch.b, batch.inv_m_b),
-            );
             let range = batch.first as usize..(batch.first + batch.count) as usize;
-            for (p, t) in points[range].iter_mut().zip(&tracks[batch.tracks()]) {
-                let hit = bouncy & t.approach.simd_lt(batch.threshold) & t.max_n.simd_gt(zero);
-                if !hit.any() {
-                    continue;
-                }
-                let vn = batch.n.dot(Side::relative(&a, &b, p.r_a, p.r_b));
-                let e = batch.restitution;
-                // Poisson: the impulse still needed to end the compression (a soft contact may
-                // not have stopped the approach by the step's end), then e times the whole
-                // compression impulse.
-                let finish = p.normal.mass * (-vn).fast_max(zero);
-                let poisson = finish + e * (t.absorbed + finish);
-                let wanted = (-p.normal.mass * (vn + e * t.approach)).fast_min(poisson);
-                let total = hit.select((p.n_imp + wanted).fast_max(zero), p.n_imp);
-                let mut imp = total - p.n_imp;
-                // work(s λ) ≤ s work(λ) for s in [0, 1]: scaling by the budget's share keeps
-                // the sum within it.
-                let cost = work(imp, vn, t.half_w).reduce_add();
-                imp *= F4::splat(budget_share(cost, budget));
-                budget -= work(imp, vn, t.half_w).reduce_add();
-                p.n_imp += imp;
-                Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
+            let (points, tracks) = (&mut points[range], &tracks[batch.tracks()]);
+            if batch.locked == Batch::UNLOCKED {
+                let sides = [
+                    Self::load(states, batch.a, batch.inv_m_a),
+                    Self::load(states, batch.b, batch.inv_m_b),
+                ];
+                bounce(batch, points, tracks, sides, states, &mut budget);
+            } else {
+                let [ma, mb] = lock_masses[batch.locked as usize];
+                let sides = [
+                    Self::load(states, batch.a, ma),
+                    Self::load(states, batch.b, mb),
+                ];
+                bounce(batch, points, tracks, sides, states, &mut budget);
             }
-            Self::store(states, batch.a, &a);
-            Self::store(states, batch.b, &b);
             Self::settle_rest(states, rest);
         }
     }
+}
+
+/// One batch's restitution impulses, within what is left of the `budget`.
+#[inline(always)]
+fn bounce<M: LinearMass>(
+    batch: &Batch,
+    points: &mut [Point],
+    tracks: &[Track],
+    [mut a, mut b]: [Side<M>; 2],
+    states: &mut [super::BodyState],
+    budget: &mut f32,
+) {
+    let zero = F4::ZERO;
+    let bouncy = batch.restitution.simd_gt(zero);
+    for (p, t) in points.iter_mut().zip(tracks) {
+        let hit = bouncy & t.approach.simd_lt(batch.threshold) & t.max_n.simd_gt(zero);
+        if !hit.any() {
+            continue;
+        }
+        let vn = batch.n.dot(Side::relative(&a, &b, p.r_a, p.r_b));
+        let e = batch.restitution;
+        // Poisson: the impulse still needed to end the compression (a soft contact may
+        // not have stopped the approach by the step's end), then e times the whole
+        // compression impulse.
+        let finish = p.normal.mass * (-vn).fast_max(zero);
+        let poisson = finish + e * (t.absorbed + finish);
+        let wanted = (-p.normal.mass * (vn + e * t.approach)).fast_min(poisson);
+        let total = hit.select((p.n_imp + wanted).fast_max(zero), p.n_imp);
+        let mut imp = total - p.n_imp;
+        // work(s λ) ≤ s work(λ) for s in [0, 1]: scaling by the budget's share keeps
+        // the sum within it.
+        let cost = work(imp, vn, t.half_w).reduce_add();
+        imp *= F4::splat(budget_share(cost, *budget));
+        *budget -= work(imp, vn, t.half_w).reduce_add();
+        p.n_imp += imp;
+        Side::push(&mut a, &mut b, batch.n, &p.normal, imp);
+    }
+    ContactSolver::store(states, batch.a, &a);
+    ContactSolver::store(states, batch.b, &b);
 }
 
 /// How much of an impulse whose work is `cost` (J) the restitution may apply with `budget`

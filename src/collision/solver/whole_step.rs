@@ -31,8 +31,8 @@ use crate::particles::{
     ExternalForce, Force, Gravity, GravityScale, LinearVelocity, Mass, Position,
 };
 use crate::rigid::{
-    AngularMomentum, AngularVelocity, ExternalTorque, Inertia, OrientationUpdate, Renormalization,
-    Rotation, Torque, free_rotation_split, turn,
+    AngularMomentum, AngularVelocity, ExternalTorque, Inertia, LockedAxes, OrientationUpdate,
+    Renormalization, Rotation, Torque, free_rotation_split, turn,
 };
 
 /// Registers the path; called by the collision plugin.
@@ -56,6 +56,7 @@ type Body<'a> = (
     Option<&'a ExternalTorque>,
     &'a mut Force,
     &'a mut Torque,
+    Option<&'a LockedAxes>,
 );
 
 /// What the schedule's integrators move: not quarantined, not asleep.
@@ -174,7 +175,7 @@ fn load(
     s.slot.clear();
     let mut next = solved;
     let mut found = 0;
-    for (e, (x, q, v, l, w, m, inertia, ext, scale, torque, ..)) in bodies {
+    for (e, (x, q, v, l, w, m, inertia, ext, scale, torque, _, _, locks)) in bodies {
         let at = if let Some(j) = solver.index.get(e, &solver.bodies) {
             found += 1;
             j as usize
@@ -185,10 +186,13 @@ fn load(
         let (Some(hot), Some(entity)) = (s.hot.get_mut(at), s.entity.get_mut(at)) else {
             return false;
         };
+        // As `hold_locked_translations` leaves them: nothing along a locked axis.
+        let free = locks.map(|l| l.translation_mask());
         let f = constant_force(m, ext, scale, g);
+        let f = free.map_or(f, |k| f * k);
         *hot = Hot {
             x: x.0,
-            v: v.0,
+            v: free.map_or(v.0, |k| v.0 * k),
             l: l.0,
             w: w.0,
             a: f * m.inverse(),
@@ -387,13 +391,14 @@ fn step(
     }
     commands.insert_resource(last);
     let bodies = bodies.iter_mut().zip(&s.slot);
-    for ((_, (mut x, mut q, mut v, mut l, mut w, m, _, ext, scale, torque, mut f, mut t)), &at) in
-        bodies
-    {
+    for ((_, body), &at) in bodies {
+        let (mut x, mut q, mut v, mut l, mut w, m, _, ext, scale, torque, mut f, mut t, locks) =
+            body;
         let b = &s.hot[at as usize];
         // The accumulators as the schedule leaves them: nothing adds to them in a world on
-        // this path, so they hold the constant force and torque.
-        f.bypass_change_detection().0 = constant_force(m, ext, scale, g);
+        // this path, so they hold the constant force and torque (without what a lock takes).
+        let force = constant_force(m, ext, scale, g);
+        f.bypass_change_detection().0 = locks.map_or(force, |l| force * l.translation_mask());
         t.bypass_change_detection().0 = torque.map_or(Vec3A::ZERO, |t| t.0);
         x.0 = b.x;
         q.0 = b.q;

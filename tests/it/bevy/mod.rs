@@ -4,6 +4,7 @@ mod app;
 mod character_in_app;
 mod collision_hooks_and_reports_in_app;
 mod debug_view;
+mod locked_axes_in_app;
 mod preludes;
 mod reflection;
 mod required_components_spawning;

@@ -122,6 +122,30 @@ fn constant_forces_torques_gravity_scales_and_kinematic_bodies_match_the_schedul
     assert_eq!(run_pair(&mut worlds, 300), 300);
 }
 
+#[test]
+fn locked_bodies_match_the_schedule() {
+    // A planar pile pushed out of its plane, and upright boxes spun about every axis.
+    let mut worlds = pair(|w| {
+        let (boxes, balls) = scenes::pile_scene(w, 16, 6).unwrap();
+        for (i, e) in boxes.into_iter().chain(balls).enumerate() {
+            let mut e = w.entity_mut(e);
+            e.insert(ExternalForce::from(Vec3::new(0.0, 0.0, 500.0)));
+            match i % 3 {
+                0 => e.insert(LockedAxes::XY_PLANE),
+                1 => e.insert((
+                    LockedAxes::new().lock_rotation_x().lock_rotation_z(),
+                    ExternalTorque::from(Vec3::new(50.0, 80.0, -30.0)),
+                )),
+                _ => e.insert((
+                    LockedAxes::new().lock_rotation_y().lock_translation_x(),
+                    AngularVelocity::from(Vec3::new(1.0, 2.0, -1.5)),
+                )),
+            };
+        }
+    });
+    assert_eq!(run_pair(&mut worlds, 240), 240);
+}
+
 /// A force written every substep by a game system: the whole-step path would skip it.
 #[derive(Component)]
 struct Hover;
@@ -246,6 +270,7 @@ fn every_substep_system_is_replicated_or_blocks_the_path() {
         "hooke::integrator::rotation::integrate_angular_momenta",
         "hooke::integrator::rotation::integrate_orientations",
         "hooke::rigid::plugin::renormalize_rotations",
+        "hooke::rigid::locked::hold_locked_translations",
         "hooke::collision::solver::plugin::solve_contacts",
         "hooke::collision::solver::plugin::relax_contacts",
         // The timing probes between the sets: nothing to replicate.

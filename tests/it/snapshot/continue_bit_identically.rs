@@ -176,6 +176,24 @@ fn pile_with_sleepers_continues_bit_identically() {
     }
 }
 
+/// The pile, every body held to its xy-plane and pushed along z: lost locks would let the
+/// copy drift out of the plane.
+fn locked_pile(world: &mut World) {
+    let (boxes, balls) = scenes::pile_scene(world, 20, 8).unwrap();
+    for e in boxes.into_iter().chain(balls) {
+        world.entity_mut(e).insert((
+            LockedAxes::XY_PLANE,
+            ExternalForce(Vec3::new(0.0, 0.0, 40.0)),
+        ));
+    }
+}
+
+#[test]
+fn a_locked_pile_continues_bit_identically() {
+    let (n, _) = round_trip(locked_pile, nothing, via_bytes);
+    assert!(n > 28, "{n} entities");
+}
+
 #[test]
 fn stack_continues_bit_identically() {
     round_trip(

@@ -12,7 +12,7 @@
 //! the snapshot format (a field added to a component) moves them too.
 //!
 //! **Updating them** after a change meant to alter results:
-//! `HOOKE_UPDATE_GOLDENS=1 cargo test --release --test determinism_goldens`, then commit the
+//! `HOOKE_UPDATE_GOLDENS=1 cargo test --release --test it determinism_goldens`, then commit the
 //! file with a note of why the results moved.
 
 use bevy_ecs::prelude::*;
