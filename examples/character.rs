@@ -113,6 +113,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let per_metre = (width - label_y - 2 * margin) as f32 / (x_range.end - x_range.start);
     let panel_h =
         (per_metre * (y_range.end - y_range.start)) as u32 + label_x + 2 * margin + caption;
+    std::fs::create_dir_all(out.parent().unwrap_or(std::path::Path::new(".")))?;
     let root = BitMapBackend::new(&out, (width, 2 * panel_h + 34)).into_drawing_area();
     root.fill(&WHITE)?;
     let root = root.titled(

@@ -65,6 +65,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         course.belt_speed
     );
 
+    std::fs::create_dir_all(out.parent().unwrap_or(std::path::Path::new(".")))?;
     let root = BitMapBackend::new(&out, (1400, 560)).into_drawing_area();
     root.fill(&WHITE)?;
     let root = root.titled(
