@@ -113,6 +113,48 @@ impl Nodes {
         Ok(())
     }
 
+    /// The indices of the nodes whose position (m) satisfies `pick`, in index order: the
+    /// nodes to pin, attach or drive, chosen by where they are rather than by searching the
+    /// indices a mesh builder handed out.
+    ///
+    /// ```
+    /// use hooke::prelude::*;
+    /// use hooke::soft::{Material, SoftBody, StrainModel, TetMesh};
+    /// let mesh = TetMesh::cuboid(Vec3::new(1.0, 0.2, 0.2), [5, 1, 1], Default::default()).unwrap();
+    /// let material = Material::new(1e6, 0.3, 1000.0).unwrap();
+    /// let (mut nodes, _body) =
+    ///     SoftBody::build(&mesh, Vec3::ZERO, material, StrainModel::Corotated).unwrap();
+    /// // A cantilever: the end face at the smallest x is clamped.
+    /// let x_min = nodes.positions().iter().map(|p| p.x).fold(f32::INFINITY, f32::min);
+    /// let clamped = nodes.pin_where(|p| p.x < x_min + 1e-4);
+    /// assert_eq!(clamped, 4);
+    /// assert_eq!(nodes.select(|p| p.x < x_min + 1e-4).len(), 4);
+    /// ```
+    #[must_use]
+    pub fn select(&self, pick: impl Fn(Vec3) -> bool) -> Vec<usize> {
+        (0..self.x.len())
+            .filter(|&i| pick(self.x[i].into()))
+            .collect()
+    }
+
+    /// The indices of the nodes inside the box from `min` to `max` (m, corners included), in
+    /// index order.
+    #[must_use]
+    pub fn within(&self, min: Vec3, max: Vec3) -> Vec<usize> {
+        self.select(|p| p.cmpge(min).all() && p.cmple(max).all())
+    }
+
+    /// Pins every node whose position satisfies `pick` (see [`Self::select`]); returns how
+    /// many it pinned.
+    pub fn pin_where(&mut self, pick: impl Fn(Vec3) -> bool) -> usize {
+        let chosen = self.select(pick);
+        for &i in &chosen {
+            // In range: `select` returned it.
+            let _ = self.pin(i);
+        }
+        chosen.len()
+    }
+
     /// Gives node `i` the mass `kg` (unpinning a pinned node).
     ///
     /// # Errors
@@ -223,5 +265,27 @@ impl Nodes {
     #[must_use]
     pub fn is_finite(&self) -> bool {
         self.x.iter().all(|x| x.is_finite()) && self.v.iter().all(|v| v.is_finite())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn nodes_are_selected_by_region_and_predicate_in_index_order() {
+        let mut nodes = Nodes::default();
+        for x in [2.0, 0.0, 1.0, -1.0] {
+            nodes.push(Vec3::new(x, 0.0, 0.0), Vec3::ZERO, 1.0).unwrap();
+        }
+        assert_eq!(nodes.select(|p| p.x >= 0.0), vec![0, 1, 2]);
+        // Corners included, a hair outside excluded.
+        assert_eq!(
+            nodes.within(Vec3::ZERO, Vec3::new(1.0, 0.0, 0.0)),
+            vec![1, 2]
+        );
+        assert!(nodes.within(Vec3::splat(0.1), Vec3::splat(0.9)).is_empty());
+        assert_eq!(nodes.pin_where(|p| p.x < 0.5), 2);
+        assert_eq!(nodes.inverse_masses(), &[1.0, 0.0, 1.0, 0.0]);
     }
 }

@@ -30,14 +30,12 @@ fn bar(young: f32, density: f32) -> (Nodes, SoftBody, Vec<usize>) {
         StrainModel::Corotated,
     )
     .unwrap();
-    let bottom: Vec<usize> = (0..nodes.len())
-        .filter(|&i| nodes.positions()[i].y < 1e-4)
-        .collect();
-    for i in 0..nodes.len() {
-        if nodes.positions()[i].y > 1.0 - 1e-4 {
-            nodes.pin(i).unwrap();
-        }
-    }
+    let bottom = nodes.select(|p| p.y < 1e-4);
+    assert_eq!(
+        nodes.pin_where(|p| p.y > 1.0 - 1e-4),
+        9,
+        "the top face's 3 × 3 nodes"
+    );
     (nodes, body, bottom)
 }
 
