@@ -261,7 +261,7 @@ fn push(
     if inverse == 0.0 {
         return Vec3::ZERO;
     }
-    let inverse_mass = Vec3::from(locks.map_or(Vec3A::splat(inverse), |l| l.inverse_mass(inverse)));
+    let inverse_mass = Vec3::from(crate::rigid::LockedAxes::inverse_mass_of(locks, inverse));
     let d = -contact.hit.normal;
     let wanted = contact.wanted.dot(d);
     if wanted <= 0.0 {

@@ -18,8 +18,8 @@ use crate::particles::{
     Position, Tracer,
 };
 use crate::rigid::{
-    AngularMomentum, CenterOfMass, ExternalImpulseAtPoint, ExternalTorque, Inertia, Rotation,
-    Torque, world_point,
+    AngularMomentum, CenterOfMass, ExternalImpulseAtPoint, ExternalTorque, Inertia, LockedAxes,
+    Rotation, Torque, world_point,
 };
 
 /// Whether any constraint (contact, joint) acts in this step. Constraint plugins set it in
@@ -186,7 +186,7 @@ pub(crate) fn apply_impulses(
             &mut LinearVelocity,
             &mut ExternalImpulse,
             &Mass,
-            Option<&crate::rigid::LockedAxes>,
+            Option<&LockedAxes>,
         ),
         (Changed<ExternalImpulse>, Simulated),
     >,
@@ -200,7 +200,7 @@ pub(crate) fn apply_impulses(
             &Position,
             &Rotation,
             Option<&CenterOfMass>,
-            Option<&crate::rigid::LockedAxes>,
+            Option<&LockedAxes>,
         ),
         (
             Changed<ExternalImpulseAtPoint>,
@@ -211,7 +211,7 @@ pub(crate) fn apply_impulses(
 ) {
     for (mut v, mut j, m, locks) in &mut bodies {
         if j.0 != Vec3::ZERO {
-            v.0 += Vec3A::from(j.0) * inverse_mass(m, locks);
+            v.0 += Vec3A::from(j.0) * LockedAxes::inverse_mass_of(locks, m.inverse());
             j.bypass_change_detection().0 = Vec3::ZERO;
         }
     }
@@ -225,18 +225,12 @@ pub(crate) fn apply_impulses(
             j.point.into()
         };
         let impulse = Vec3A::from(j.impulse);
-        v.0 += impulse * inverse_mass(m, locks);
+        v.0 += impulse * LockedAxes::inverse_mass_of(locks, m.inverse());
         if !inertia.is_infinite() {
             l.0 += (p - x.0).cross(impulse);
         }
         j.bypass_change_detection().impulse = Vec3::ZERO;
     }
-}
-
-/// The inverse mass per world axis: zero along a locked one.
-#[inline]
-fn inverse_mass(m: &Mass, locks: Option<&crate::rigid::LockedAxes>) -> Vec3A {
-    locks.map_or(Vec3A::splat(m.inverse()), |l| l.inverse_mass(m.inverse()))
 }
 
 /// The velocity half of a step; explicit Euler does its whole step here.

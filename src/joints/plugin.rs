@@ -172,8 +172,7 @@ fn load(bodies: &Bodies, e: Option<Entity>, anchor: Vec3) -> (Side, Vec3A) {
     }
     side.moves = mass.is_some_and(|m| m.inverse() > 0.0);
     side.v = v.map_or(Vec3A::ZERO, |v| v.0);
-    let inverse = mass.map_or(0.0, Mass::inverse);
-    side.inv_m = locks.map_or(Vec3A::splat(inverse), |l| l.inverse_mass(inverse));
+    side.inv_m = crate::rigid::LockedAxes::inverse_mass_of(locks, mass.map_or(0.0, Mass::inverse));
     match (inertia, l) {
         (Some(i), Some(l)) if !i.is_infinite() => {
             side.w = i.angular_velocity(q.0, l.0);

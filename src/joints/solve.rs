@@ -365,7 +365,6 @@ fn outer(a: Vec3A, b: Vec3A) -> Mat3A {
     Mat3A::from_cols(a * b.x, a * b.y, a * b.z)
 }
 
-/// The inverse of a symmetric positive definite 3 × 3, or None when it is not invertible.
 /// `k` with 1 on the diagonal of each row and column that is exactly zero: a world axis
 /// that [`crate::rigid::LockedAxes`] keeps both sides from moving along. Its λ then moves
 /// nothing, and the other axes are solved as if it were not there (otherwise the singular
@@ -384,6 +383,7 @@ pub(super) fn free_of_locks(mut k: Mat3A) -> Mat3A {
     k
 }
 
+/// The inverse of a symmetric positive definite 3 × 3, or None when it is not invertible.
 fn invert(m: Mat3A) -> Option<Mat3A> {
     let det = m.determinant();
     (det.is_finite() && det > 0.0).then(|| m.inverse())

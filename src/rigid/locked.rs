@@ -171,6 +171,13 @@ impl LockedAxes {
         self.translation_mask() * inverse
     }
 
+    /// [`Self::inverse_mass`] of a body that may have no locks: `inverse` along every axis
+    /// then.
+    #[must_use]
+    pub fn inverse_mass_of(locks: Option<&Self>, inverse: f32) -> Vec3A {
+        locks.map_or(Vec3A::splat(inverse), |l| l.inverse_mass(inverse))
+    }
+
     /// The translation bits (0–2: x, y, z).
     #[must_use]
     pub(crate) const fn translation_bits(self) -> u8 {
@@ -285,10 +292,7 @@ impl Inertia {
 ///
 /// A sleeping body wakes when its locks change: what held it may have let go.
 fn locks_inserted(mut world: DeferredWorld, ctx: HookContext) {
-    let bits = world
-        .get::<LockedAxes>(ctx.entity)
-        .map_or(0, |l| l.rotation_bits());
-    set_inertia_locks(&mut world, ctx.entity, bits);
+    copy_locks(&mut world, ctx.entity);
     crate::core::rest::wake(&mut world, ctx.entity);
 }
 
@@ -300,10 +304,15 @@ fn locks_removed(mut world: DeferredWorld, ctx: HookContext) {
 
 /// ...and on a new [`Inertia`] (a kind change, a new collider's mass, a user's value).
 pub(super) fn lock_inserted_inertia(mut world: DeferredWorld, ctx: HookContext) {
+    copy_locks(&mut world, ctx.entity);
+}
+
+/// Copies `entity`'s rotation locks (none without a [`LockedAxes`]) into its [`Inertia`].
+fn copy_locks(world: &mut DeferredWorld, entity: Entity) {
     let bits = world
-        .get::<LockedAxes>(ctx.entity)
+        .get::<LockedAxes>(entity)
         .map_or(0, |l| l.rotation_bits());
-    set_inertia_locks(&mut world, ctx.entity, bits);
+    set_inertia_locks(world, entity, bits);
 }
 
 fn set_inertia_locks(world: &mut DeferredWorld, entity: Entity, bits: u8) {

@@ -270,10 +270,11 @@ fn solve_link(
         x: Vec3::from(x.0),
         v: v.as_ref().map_or(Vec3::ZERO, |v| Vec3::from(v.0)),
         w: w.as_ref().map_or(Vec3::ZERO, |w| Vec3::from(w.0)),
-        inv_mass: {
-            let inverse = mass.map_or(0.0, |m| m.inverse());
-            locks.map_or(Vec3::splat(inverse), |l| l.inverse_mass(inverse).into())
-        },
+        inv_mass: crate::rigid::LockedAxes::inverse_mass_of(
+            locks,
+            mass.map_or(0.0, |m| m.inverse()),
+        )
+        .into(),
         inv_inertia: inertia.map_or(Mat3::ZERO, |i| i.world_inverse_tensor(q.0)),
         dynamic: false,
         linear: Vec3::ZERO,

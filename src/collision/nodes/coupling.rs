@@ -208,7 +208,7 @@ pub(crate) fn apply_node_impulses(mut bodies: Query<Pending, Without<Quarantined
             continue;
         }
         let p = std::mem::take(pending.bypass_change_detection());
-        let inverse = locks.map_or(Vec3A::splat(m.inverse()), |l| l.inverse_mass(m.inverse()));
+        let inverse = crate::rigid::LockedAxes::inverse_mass_of(locks, m.inverse());
         v.0 += Vec3A::from(p.linear) * inverse;
         let l = l.bypass_change_detection();
         l.0 += Vec3A::from(p.angular);

@@ -106,9 +106,7 @@ fn side_of(x: &Position, q: &Rotation, d: Option<Dynamics<'_>>) -> Option<RigidS
         x: Vec3::from(x.0),
         v: Vec3::from(v.0),
         w: Vec3::from(w.0),
-        inv_mass: locks
-            .map_or(Vec3A::splat(m.inverse()), |l| l.inverse_mass(m.inverse()))
-            .into(),
+        inv_mass: crate::rigid::LockedAxes::inverse_mass_of(locks, m.inverse()).into(),
         inv_inertia: i.world_inverse_tensor(q.0),
         dynamic: m.inverse() > 0.0 || !i.is_infinite(),
         linear: Vec3::ZERO,
