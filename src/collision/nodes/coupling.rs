@@ -24,6 +24,31 @@ use crate::integrator::skyline::SkylineCholesky;
 use crate::particles::{LinearVelocity, Mass, Nodes};
 use crate::rigid::{AngularMomentum, AngularVelocity, Inertia, Rotation};
 
+/// An impulse's row: the nodes it acts on with their weights (one node of weight 1, or a
+/// triangle's corners at a point between them) and its unit direction.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Row {
+    pub parts: [(usize, f32); 3],
+    pub count: usize,
+    pub dir: Vec3,
+}
+
+impl Row {
+    /// One node.
+    #[must_use]
+    pub fn node(i: usize, dir: Vec3) -> Self {
+        Self {
+            parts: [(i, 1.0); 3],
+            count: 1,
+            dir,
+        }
+    }
+
+    fn parts(&self) -> &[(usize, f32)] {
+        &self.parts[..self.count]
+    }
+}
+
 /// The soft body's response G_soft for impulses along `rows` = (node, unit direction): one
 /// solve with the factor per row, or the lumped inverse masses without one.
 pub(crate) fn soft_response(
@@ -32,13 +57,29 @@ pub(crate) fn soft_response(
     rows: &[(usize, Vec3)],
     h: f32,
 ) -> DMatrix<f64> {
+    let rows: Vec<Row> = rows.iter().map(|&(i, d)| Row::node(i, d)).collect();
+    soft_response_of(n, factor, &rows, h)
+}
+
+/// G_soft for weighted rows: G_kl = Σₐ Σ_b wₐ w_b d_kᵀ W_soft(a, b) d_l.
+pub(crate) fn soft_response_of(
+    n: &Nodes,
+    factor: Option<&SkylineCholesky>,
+    rows: &[Row],
+    h: f32,
+) -> DMatrix<f64> {
     let a = rows.len();
     let mut g = DMatrix::<f64>::zeros(a, a);
     let Some(factor) = factor else {
-        for (k, &(i, d)) in rows.iter().enumerate() {
-            for (l, &(j, e)) in rows.iter().enumerate() {
-                if i == j {
-                    g[(k, l)] = f64::from(n.inv_mass[i]) * f64::from(d.dot(e));
+        for (k, r) in rows.iter().enumerate() {
+            for (l, s) in rows.iter().enumerate() {
+                let de = f64::from(r.dir.dot(s.dir));
+                for &(i, wi) in r.parts() {
+                    for &(j, wj) in s.parts() {
+                        if i == j {
+                            g[(k, l)] += f64::from(wi * wj) * f64::from(n.inv_mass[i]) * de;
+                        }
+                    }
                 }
             }
         }
@@ -50,12 +91,22 @@ pub(crate) fn soft_response(
     let h = if factor.step > 0.0 { factor.step } else { h };
     let inv_h2 = 1.0 / (f64::from(h) * f64::from(h));
     let (mut e, mut z, mut work) = (vec![DVec3::ZERO; len], vec![DVec3::ZERO; len], vec![]);
-    for (l, &(j, d)) in rows.iter().enumerate() {
-        e[j] = d.as_dvec3();
+    for (l, s) in rows.iter().enumerate() {
+        for &(j, wj) in s.parts() {
+            e[j] += (s.dir * wj).as_dvec3();
+        }
         factor.solve(&e, &mut z, &mut work);
-        e[j] = DVec3::ZERO;
-        for (k, &(i, d)) in rows.iter().enumerate() {
-            g[(k, l)] = z[i].dot(d.as_dvec3()) * inv_h2;
+        for &(j, _) in s.parts() {
+            e[j] = DVec3::ZERO;
+        }
+        for (k, r) in rows.iter().enumerate() {
+            let d = r.dir.as_dvec3();
+            g[(k, l)] = r
+                .parts()
+                .iter()
+                .map(|&(i, wi)| f64::from(wi) * z[i].dot(d))
+                .sum::<f64>()
+                * inv_h2;
         }
     }
     g

@@ -1,6 +1,10 @@
-//! Mesh nodes (soft bodies, cloth) against colliders: point projection with a thickness and
-//! Coulomb friction, after the positions are integrated. Each effect whose meshes collide
-//! implements [`NodeLayer`] for its component and registers [`collide_nodes`] for it.
+//! Meshes (soft bodies, cloth) against colliders: their nodes and the triangles between them
+//! kept a thickness out of every collider, with Coulomb friction, after the positions are
+//! integrated. Each effect whose meshes collide implements [`NodeLayer`] for its component
+//! (and hands its surface's triangles to it) and registers [`collide_nodes`] for it. What
+//! counts as a contact, a node's or a point inside a triangle's, is in `hits`; how each is
+//! pushed out is in `push`. A point inside a triangle is moved as its corners are, each by
+//! its barycentric weight over its mass.
 //!
 //! A node closer than the layer's thickness (e.g. [`crate::soft::SoftBody::contact_thickness`])
 //! to a collider's surface (or inside it)
@@ -23,8 +27,8 @@
 //! must close, G λ ≥ −C / h, with G the coupled response of both sides (see
 //! [`crate::collision::nodes::coupling`]: the soft body answers through its implicit solve's factor, so a stiff
 //! body moves as a whole; a light body is pushed back by the heavy soft one). Projected
-//! Gauss–Seidel on that small system, then Coulomb friction per node capped at μ λ; the body
-//! takes −λ at each node. No plane holds a node to a dynamic body inside the solve: such a
+//! Gauss–Seidel on that small system, then Coulomb friction per contact capped at μ λ; the
+//! body takes −λ at each node, or at its own surface point facing a triangle. No plane holds a node to a dynamic body inside the solve: such a
 //! wall would not give, and a light body loaded with a heavy soft one's weight one substep
 //! late bounces off. The body takes its impulses at the start of the next substep
 //! ([`NodeImpulse`]), before its own integrator and rigid contacts.
@@ -38,27 +42,20 @@
 //! Soft–soft contact is not handled.
 
 pub(crate) mod coupling;
+mod hits;
+mod push;
 
 use bevy_ecs::prelude::*;
-use glam::{Quat, Vec3, Vec3A};
-use parry3d::math::Pose;
+use glam::Vec3;
 
-use crate::collision::nodes::coupling::{NodeImpulse, RigidSide, move_soft, soft_response};
+use crate::collision::nodes::coupling::{NodeImpulse, RigidSide};
 use crate::collision::{Collider, ColliderAabb, ColliderOf, ContactSettings, Friction};
 use crate::core::quarantine::Quarantined;
 use crate::core::time::SubstepTime;
 use crate::integrator::implicit::ContactPlane;
-use crate::integrator::skyline::SkylineCholesky;
 use crate::integrator::{ImplicitEuler, ImplicitState};
 use crate::particles::{LinearVelocity, Mass, Nodes, Position};
 use crate::rigid::{AngularVelocity, CenterOfMass, Inertia, Rotation};
-
-/// The most nodes in one dynamic body's layer whose impulses are found with the soft body's
-/// full response (one factor solve each); past it, with the lumped masses.
-const MAX_COUPLED: usize = 64;
-
-/// Projected Gauss–Seidel passes over the nodes touching one dynamic body.
-const CONTACT_PASSES: usize = 30;
 
 type ColliderPose<'a> = (
     Entity,
@@ -90,6 +87,10 @@ pub(crate) trait NodeLayer: Component<Mutability = bevy_ecs::component::Mutable>
     fn contacts_mut(&mut self) -> &mut Vec<ContactPlane>;
     /// Told when its nodes press on a dynamic body.
     fn touched_a_body(&mut self) {}
+    /// The surface's triangles (node indices), for contacts between nodes; none by default.
+    fn triangles(&self) -> &[[u32; 3]] {
+        &[]
+    }
 }
 
 type Mesh<'a, L> = (
@@ -119,6 +120,7 @@ fn side_of(x: &Position, q: &Rotation, d: Option<Dynamics<'_>>) -> Option<RigidS
 pub(crate) struct NodeScratch {
     meshes: Vec<Entity>,
     near: Vec<Entity>,
+    manifolds: hits::FaceManifolds,
 }
 
 /// Projects every soft body's nodes out of the colliders they touch.
@@ -143,7 +145,11 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
             s.max_push_velocity
         }),
     };
-    let NodeScratch { meshes, near } = &mut *scratch;
+    let NodeScratch {
+        meshes,
+        near,
+        manifolds,
+    } = &mut *scratch;
     // Bodies that get their first soft impulse this substep (inserted at its end).
     let mut fresh: Vec<(Entity, NodeImpulse)> = Vec::new();
     meshes.clear();
@@ -196,8 +202,28 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
             let mut rigid = side_of(x, q, d);
             // Guarded as pair geometry is (parry asserts on some degenerate inputs): a mesh
             // whose contact with this collider fails leaves, named with it.
+            let motion = match &rigid {
+                Some(side) => hits::Motion::new(
+                    pose,
+                    side.x,
+                    side.v,
+                    side.w,
+                    crate::collision::radius(c, com),
+                    h,
+                ),
+                None => hits::Motion::new(pose, Vec3::ZERO, Vec3::ZERO, Vec3::ZERO, 0.0, h),
+            };
+            let triangles = body.triangles();
             let found = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                find_hits(n, c, &pose, q.0, aabb, thickness, h)
+                let shape = &**c.shape();
+                let mut hits = hits::node_hits(n, shape, &motion, aabb, thickness, h);
+                share_the_way_out(&mut hits, n, rigid.as_ref(), push, Vec3::from(x.0));
+                let mut faces = Vec::new();
+                hits::face_hits(
+                    n, triangles, shape, &motion, aabb, thickness, h, &hits, manifolds, &mut faces,
+                );
+                hits.extend(faces);
+                hits
             }));
             let Ok(hits) = found else {
                 commands.entity(mesh).try_insert(Quarantined {
@@ -210,16 +236,14 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
             if hits.is_empty() {
                 continue;
             }
-            let mut hits = hits;
-            share_the_way_out(&mut hits, n, rigid.as_ref(), push, Vec3::from(x.0));
             match rigid.as_mut() {
                 Some(side) if side.dynamic => {
-                    push_dynamic(n, side, &hits, factor, friction.0, push);
+                    push::push_dynamic(n, side, &hits, factor, friction.0, push);
                     body.touched_a_body();
                 }
                 other => {
                     let side = other.map(|s| &*s);
-                    push_immovable(n, body.contacts_mut(), side, &hits, friction.0, push);
+                    push::push_immovable(n, body.contacts_mut(), side, &hits, friction.0, push);
                 }
             }
             // The body takes the impulses at the start of the next substep (see
@@ -253,19 +277,11 @@ pub(crate) fn collide_nodes<L: NodeLayer>(
     }
 }
 
-/// A node in a collider's contact layer: its outward normal (world) and its overlap with
-/// the layer (m, positive inside).
-struct Hit {
-    node: usize,
-    normal: Vec3,
-    overlap: f32,
-}
-
 /// How far overlaps are closed in one substep.
 #[derive(Clone, Copy)]
-struct Push {
+pub(super) struct Push {
     /// The substep (s).
-    h: f32,
+    pub(super) h: f32,
     /// The fastest an overlap older than this substep is closed (m/s).
     max_push: f32,
 }
@@ -276,8 +292,18 @@ impl Push {
     /// older overlap at `max_push`. Bounds the speed a mesh spawned deep inside a collider
     /// comes out at, as the rigid contacts do.
     #[must_use]
-    fn closed(self, overlap: f32, approach: f32) -> f32 {
+    pub(super) fn closed(self, overlap: f32, approach: f32) -> f32 {
         overlap.min((approach.max(0.0) + self.max_push) * self.h)
+    }
+
+    /// As [`Push::closed`], but older overlap only a fifth at a time: for a point between
+    /// nodes, which its pinned or stiff neighbours can make as hard as a wall. Closing all of
+    /// it at once would hand the body back the approach it had, a full bounce (a crate pushed
+    /// across a cloth bridge was thrown back off the ramp at its pinned end).
+    #[must_use]
+    pub(super) fn closed_gently(self, overlap: f32, approach: f32) -> f32 {
+        let new = (approach.max(0.0) * self.h).min(overlap);
+        new + (0.2 * (overlap - new)).min(self.max_push * self.h)
     }
 }
 
@@ -288,7 +314,7 @@ impl Push {
 /// (a jelly inside a box was pulled to all six faces and went non-finite in three steps).
 /// Shallow hits, every contact of a mesh that did not start inside, keep their own normals.
 fn share_the_way_out(
-    hits: &mut [Hit],
+    hits: &mut [hits::Hit],
     n: &Nodes,
     side: Option<&RigidSide>,
     push: Push,
@@ -297,9 +323,9 @@ fn share_the_way_out(
     let deep: Vec<bool> = hits
         .iter()
         .map(|hit| {
-            let p = Vec3::from(n.x[hit.node]);
+            let p = hit.point(n);
             let base = side.map_or(Vec3::ZERO, |s| s.point_velocity(p));
-            let approach = -(Vec3::from(n.v[hit.node]) - base).dot(hit.normal);
+            let approach = -(hit.velocity(n) - base).dot(hit.normal);
             push.closed(hit.overlap, approach) < hit.overlap
         })
         .collect();
@@ -310,7 +336,7 @@ fn share_the_way_out(
     let (mut sum, mut centroid, mut first) = (Vec3::ZERO, Vec3::ZERO, None);
     for (hit, _) in hits.iter().zip(&deep).filter(|(_, d)| **d) {
         sum += hit.normal;
-        centroid += Vec3::from(n.x[hit.node]);
+        centroid += hit.point(n);
         first.get_or_insert(hit.normal);
     }
     let way = if sum.length() >= 0.25 * count as f32 {
@@ -340,291 +366,4 @@ fn swept_bounds(n: &Nodes, h: f32) -> Option<(Vec3, Vec3)> {
                 (lo.min(x).min(back), hi.max(x).max(back))
             }),
     )
-}
-
-/// The surface a fast node crossed within the substep: its sweep from `start` to `end` (in
-/// the collider's frame, `start` outside the shape) enters the shape. The hit's outward
-/// normal and the overlap that puts the node back `thickness` outside the entry point.
-fn crossed(
-    shape: &dyn parry3d::shape::Shape,
-    start: Vec3,
-    end: Vec3,
-    thickness: f32,
-) -> Option<(Vec3, f32)> {
-    if shape.contains_local_point(start) {
-        return None;
-    }
-    let ray = parry3d::query::Ray::new(start, end - start);
-    let hit = shape.cast_local_ray_and_get_normal(&ray, 1.0, true)?;
-    let n = hit.normal;
-    let entry = ray.point_at(hit.time_of_impact);
-    (n.is_finite() && n != Vec3::ZERO).then(|| (n, thickness + (entry - end).dot(n)))
-}
-
-fn find_hits(
-    n: &Nodes,
-    collider: &Collider,
-    pose: &Pose,
-    rotation: Quat,
-    aabb: &ColliderAabb,
-    thickness: f32,
-    h: f32,
-) -> Vec<Hit> {
-    let shape = collider.shape();
-    let inverse = pose.inverse();
-    let mut hits = Vec::new();
-    for i in 0..n.x.len() {
-        if n.inv_mass[i] == 0.0 {
-            continue;
-        }
-        let p = Vec3::from(n.x[i]);
-        let step = Vec3::from(n.v[i]) * h;
-        let back = p - step;
-        let (lo, hi) = (p.min(back), p.max(back));
-        if (hi + Vec3::splat(thickness)).cmplt(aabb.min).any()
-            || (lo - Vec3::splat(thickness)).cmpgt(aabb.max).any()
-        {
-            continue;
-        }
-        let local = inverse * p;
-        if !local.is_finite() || !step.is_finite() {
-            // A node gone non-finite is caught by its own check; projecting it would trip
-            // parry's asserts (NaN against a capsule of half height 0).
-            continue;
-        }
-        // A node that moved more than the contact distance this substep may have crossed
-        // the surface, or a thin shape whole: the sweep's entry decides, since a point test
-        // at its end would push it out of the far side (a soft cube at 300 m/s under
-        // implicit integration went through the ground).
-        if step.length_squared() > thickness * thickness
-            && let Some((normal_local, overlap)) =
-                crossed(&**shape, inverse * back, local, thickness)
-        {
-            hits.push(Hit {
-                node: i,
-                normal: rotation * normal_local,
-                overlap,
-            });
-            continue;
-        }
-        let Some((normal_local, depth)) = nearest_surface(&**shape, local, thickness) else {
-            continue;
-        };
-        hits.push(Hit {
-            node: i,
-            normal: rotation * normal_local,
-            overlap: thickness - depth,
-        });
-    }
-    hits
-}
-
-/// The outward normal at the surface nearest to `local` and its signed distance from it
-/// (m, negative inside), if it is closer than `thickness` or inside.
-///
-/// Inside a convex hull the nearest face plane decides, exactly: parry's projection onto a
-/// hull runs GJK with a tolerance that grows with the shape, and called a point 2.7 cm
-/// below a 720 m hull inside, so a jelly falling out of it had nodes pulled back and
-/// stopped (a 79 m/s jolt).
-fn nearest_surface(
-    shape: &dyn parry3d::shape::Shape,
-    local: Vec3,
-    thickness: f32,
-) -> Option<(Vec3, f32)> {
-    let inside = match shape.as_convex_polyhedron() {
-        Some(hull) => match deepest_face(hull, local) {
-            Some((normal, distance)) if distance <= 0.0 => return Some((normal, distance)),
-            _ => false,
-        },
-        None => shape.project_local_point(local, true).is_inside,
-    };
-    if inside {
-        // Inside: the solid projection is the point itself; the surface is the way out.
-        let out = shape.project_local_point(local, false).point - local;
-        let d = out.length();
-        return (d > 0.0).then(|| (out / d, -d));
-    }
-    let off = local - shape.project_local_point(local, false).point;
-    let d = off.length();
-    (d < thickness && d > 0.0).then(|| (off / d, d))
-}
-
-/// The face of `hull` whose plane `p` is farthest out of (or least deep behind): its outward
-/// normal and that signed distance (m). For a point inside, the nearest surface.
-fn deepest_face(hull: &parry3d::shape::ConvexPolyhedron, p: Vec3) -> Option<(Vec3, f32)> {
-    let (points, corners) = (hull.points(), hull.vertices_adj_to_face());
-    hull.faces()
-        .iter()
-        .filter_map(|face| {
-            let corner = points.get(*corners.get(face.first_vertex_or_edge as usize)? as usize)?;
-            Some((face.normal, face.normal.dot(p - *corner)))
-        })
-        .max_by(|a, b| a.1.total_cmp(&b.1))
-}
-
-/// A static or kinematic collider: each node is moved out and stops on its own, relative to
-/// the surface's velocity, and leaves a plane for the implicit solve.
-fn push_immovable(
-    n: &mut Nodes,
-    contacts: &mut Vec<ContactPlane>,
-    side: Option<&RigidSide>,
-    hits: &[Hit],
-    mu: f32,
-    push: Push,
-) {
-    for hit in hits {
-        let i = hit.node;
-        let at = Vec3::from(n.x[i]);
-        let base = side.map_or(Vec3::ZERO, |b| b.point_velocity(at));
-        let approach = -(Vec3::from(n.v[i]) - base).dot(hit.normal);
-        let closed = push.closed(hit.overlap, approach);
-        n.x[i] += Vec3A::from(hit.normal * closed);
-        let p = Vec3::from(n.x[i]);
-        let base = side.map_or(Vec3::ZERO, |b| b.point_velocity(p));
-        let rel = Vec3::from(n.v[i]) - base;
-        let vn = rel.dot(hit.normal);
-        // Only the approach bears friction. The push out of older overlap does not: a
-        // deeply embedded mesh whose every node friction stopped each substep would be
-        // stepped as x += h² F / m, stable only to half the explicit limit (a jelly inside
-        // a 236 m cylinder blew up after 3.7 s); it slides along the inside instead.
-        if vn < 0.0 {
-            let tangent = rel - vn * hit.normal;
-            let speed = tangent.length();
-            let slowed = if speed > 0.0 {
-                tangent * ((speed + mu * vn).max(0.0) / speed)
-            } else {
-                tangent
-            };
-            n.v[i] = Vec3A::from(base + slowed);
-        }
-        contacts.push(ContactPlane {
-            node: i as u32,
-            normal: hit.normal,
-            offset: hit.normal.dot(p) + push.h * hit.normal.dot(base),
-        });
-    }
-}
-
-/// A dynamic body: the normal impulses that close every overlap together (projected
-/// Gauss–Seidel on the coupled response), then friction node by node.
-fn push_dynamic(
-    n: &mut Nodes,
-    side: &mut RigidSide,
-    hits: &[Hit],
-    factor: Option<&SkylineCholesky>,
-    mu: f32,
-    push: Push,
-) {
-    let h = push.h;
-    if hits.len() > MAX_COUPLED {
-        push_many(n, side, hits, mu, push);
-        return;
-    }
-    let rows: Vec<(usize, Vec3)> = hits.iter().map(|h| (h.node, h.normal)).collect();
-    let at: Vec<(Vec3, Vec3)> = hits
-        .iter()
-        .map(|h| (Vec3::from(n.x[h.node]), h.normal))
-        .collect();
-    let g = soft_response(n, factor, &rows, h) + side.response(&at);
-    // G λ ≥ C / h: each overlap closed over the substep (deep ones at the push speed).
-    let target: Vec<f64> = hits
-        .iter()
-        .map(|hit| {
-            let p = Vec3::from(n.x[hit.node]);
-            let approach = -(Vec3::from(n.v[hit.node]) - side.point_velocity(p)).dot(hit.normal);
-            f64::from(push.closed(hit.overlap, approach)) / f64::from(h)
-        })
-        .collect();
-    let a = hits.len();
-    let mut lambda = vec![0.0f64; a];
-    for _ in 0..CONTACT_PASSES {
-        for k in 0..a {
-            let diag = g[(k, k)];
-            if diag <= 0.0 {
-                continue;
-            }
-            let reached: f64 = (0..a).map(|l| g[(k, l)] * lambda[l]).sum();
-            lambda[k] = (lambda[k] + (target[k] - reached) / diag).max(0.0);
-        }
-    }
-    let impulses: Vec<(usize, Vec3)> = hits
-        .iter()
-        .zip(&lambda)
-        .filter(|(_, l)| **l > 0.0)
-        .map(|(h, &l)| (h.node, h.normal * l as f32))
-        .collect();
-    move_soft(n, factor, &impulses, h);
-    for &(i, j) in &impulses {
-        side.take(Vec3::from(n.x[i]), -j);
-    }
-    // Friction node by node, capped by each node's normal impulse.
-    for (hit, &l) in hits.iter().zip(&lambda) {
-        if l <= 0.0 {
-            continue;
-        }
-        let i = hit.node;
-        let p = Vec3::from(n.x[i]);
-        let rel = Vec3::from(n.v[i]) - side.point_velocity(p);
-        let tangent = rel - rel.dot(hit.normal) * hit.normal;
-        let speed = tangent.length();
-        if speed == 0.0 {
-            continue;
-        }
-        let dir = tangent / speed;
-        let stop = speed / (n.inv_mass[i] + side.inverse_mass_along(p, dir));
-        let j = -stop.min(mu * l as f32) * dir;
-        n.v[i] += Vec3A::from(n.inv_mass[i] * j);
-        side.take(p, -j);
-    }
-}
-
-/// Many nodes on one dynamic body: the same impulses node by node, each node with its own
-/// mass (no dense response), several passes so that no node's place in the order favours it.
-fn push_many(n: &mut Nodes, side: &mut RigidSide, hits: &[Hit], mu: f32, push: Push) {
-    let h = push.h;
-    // The push-out each overlap may have, fixed by the approach before any impulse.
-    let bias: Vec<f32> = hits
-        .iter()
-        .map(|hit| {
-            let p = Vec3::from(n.x[hit.node]);
-            let approach = -(Vec3::from(n.v[hit.node]) - side.point_velocity(p)).dot(hit.normal);
-            push.closed(hit.overlap, approach) / h
-        })
-        .collect();
-    let mut normal_impulse = vec![0.0f32; hits.len()];
-    let mut friction_impulse = vec![Vec3::ZERO; hits.len()];
-    for _ in 0..CONTACT_PASSES.min(8) {
-        for (k, hit) in hits.iter().enumerate() {
-            let i = hit.node;
-            let inv_node = n.inv_mass[i];
-            let p = Vec3::from(n.x[i]);
-            let rel = Vec3::from(n.v[i]) - side.point_velocity(p);
-            let vn = rel.dot(hit.normal);
-            let total = (normal_impulse[k]
-                + (bias[k] - vn) / (inv_node + side.inverse_mass_along(p, hit.normal)))
-            .max(0.0);
-            let mut j = (total - normal_impulse[k]) * hit.normal;
-            normal_impulse[k] = total;
-            let tangent = rel - vn * hit.normal;
-            let speed = tangent.length();
-            let mut friction = friction_impulse[k];
-            if speed > 0.0 {
-                let dir = tangent / speed;
-                friction -= speed / (inv_node + side.inverse_mass_along(p, dir)) * dir;
-            }
-            let cap = mu * total;
-            if friction.length() > cap {
-                friction *= cap / friction.length();
-            }
-            j += friction - friction_impulse[k];
-            friction_impulse[k] = friction;
-            n.v[i] += Vec3A::from(inv_node * j);
-            side.take(p, -j);
-        }
-    }
-    // The velocities carry the nodes out over the next substep; move them now as well, as the
-    // coupled path does (Δx = h Δv), by the normal part.
-    for (hit, &l) in hits.iter().zip(&normal_impulse) {
-        n.x[hit.node] += Vec3A::from(h * n.inv_mass[hit.node] * l * hit.normal);
-    }
 }
