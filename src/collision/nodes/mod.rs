@@ -297,9 +297,9 @@ impl Push {
     }
 
     /// As [`Push::closed`], but older overlap only a fifth at a time: for a point between
-    /// nodes, which its pinned or stiff neighbours can make as hard as a wall. Closing all of
-    /// it at once would hand the body back the approach it had, a full bounce (a crate pushed
-    /// across a cloth bridge was thrown back off the ramp at its pinned end).
+    /// nodes, which its pinned or stiff neighbours can make as hard as a wall, and whose body
+    /// takes its share one substep late. Closing all of the older overlap at once would hand
+    /// the body back the approach it had, as a bounce.
     #[must_use]
     pub(super) fn closed_gently(self, overlap: f32, approach: f32) -> f32 {
         let new = (approach.max(0.0) * self.h).min(overlap);

@@ -139,17 +139,9 @@ pub(super) fn push_dynamic(
         }
     }
     move_soft(n, factor, &impulses, h);
-    for ((hit, &l), &(p, _)) in hits.iter().zip(&lambda).zip(&at) {
-        if l > 0.0 {
-            side.take(
-                if hit.single().is_some() {
-                    hit.point(n)
-                } else {
-                    p
-                },
-                -hit.normal * l as f32,
-            );
-        }
+    // A node's contact acts where the node now is; a face's, at the body's surface point.
+    for (hit, &l) in hits.iter().zip(&lambda).filter(|(_, l)| **l > 0.0) {
+        side.take(hit.on_body(n), -hit.normal * l as f32);
     }
     // Friction hit by hit, capped by each one's normal impulse.
     for (hit, &l) in hits.iter().zip(&lambda) {
@@ -172,13 +164,17 @@ pub(super) fn push_dynamic(
 }
 
 fn row_of(hit: &Hit) -> Row {
-    let mut row = Row::node(0, hit.normal);
-    row.count = 0;
-    for (k, part) in hit.parts().enumerate() {
-        row.parts[k] = part;
-        row.count = k + 1;
+    let mut parts = [(0, 0.0); 3];
+    let mut count = 0;
+    for (slot, part) in parts.iter_mut().zip(hit.parts()) {
+        *slot = part;
+        count += 1;
     }
-    row
+    Row {
+        parts,
+        count,
+        dir: hit.normal,
+    }
 }
 
 /// Many hits on one dynamic body: the same impulses hit by hit, each with its own lumped
